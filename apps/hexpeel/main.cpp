@@ -1,0 +1,2 @@
+// hexpeel command line (being written).
+int main() { return 0; }

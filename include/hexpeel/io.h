@@ -1,0 +1,45 @@
+// Reading and writing files. The format is chosen by the file extension (case-insensitive).
+//
+// Surfaces (read): .obj  .off  .ply (ASCII, binary little/big endian)  .mesh (MEDIT, Quadrilaterals)
+//                  .msh (Gmsh 2.2 and 4.1, ASCII and binary; quad elements)  .vtk (legacy, POLYDATA
+//                  POLYGONS or UNSTRUCTURED_GRID cells)
+// Surfaces (write): .obj .off (for dumping intermediate surfaces)
+// Hex meshes (read and write): .vtk (legacy ASCII)  .vtu (VTK XML, ASCII)  .mesh (MEDIT)
+//                              .msh (Gmsh 4.1 ASCII)
+//
+// Readers never crash on any bytes: every problem comes back as a Status naming the line (or
+// byte offset) and what was expected. Writers write to a temporary file beside the target and
+// rename it at the end, so a failed write leaves nothing behind.
+#pragma once
+
+#include "hexpeel/hex_mesh.h"
+#include "hexpeel/quad_surface.h"
+#include "hexpeel/status.h"
+
+#include <filesystem>
+#include <string>
+
+namespace hexpeel {
+
+/// Reads the polygons of a surface file. Indices are checked against the point count.
+Status read_surface(const std::filesystem::path& path, PolygonSoup& out);
+
+/// Writes a quad surface (.obj or .off), atomically.
+Status write_surface(const std::filesystem::path& path, const QuadSurface& surface);
+
+/// Reads a hex mesh; other cell types are skipped when `others` is given (their count is added),
+/// otherwise they are an error. Hex corners come back in VTK order.
+Status read_hex_mesh(const std::filesystem::path& path, HexMesh& out, int64_t* others = nullptr);
+
+/// Writes a hex mesh in the format its extension names, atomically, with full double precision.
+Status write_hex_mesh(const std::filesystem::path& path, const HexMesh& mesh);
+
+/// Writes `text` to `path` atomically (temporary file + rename). Used for reports too.
+Status write_text_file(const std::filesystem::path& path, const std::string& text);
+
+/// True when the extension names a hex-mesh format we write.
+bool is_hex_mesh_extension(const std::filesystem::path& path);
+/// True when the extension names a surface format we read.
+bool is_surface_extension(const std::filesystem::path& path);
+
+}  // namespace hexpeel

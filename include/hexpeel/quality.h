@@ -1,0 +1,74 @@
+// Quality of a hex mesh: Verdict's hex scaled Jacobian, singular edges, Euler characteristic,
+// ball test, and (optionally) whether the mesh's boundary equals a given surface.
+#pragma once
+
+#include "hexpeel/context.h"
+#include "hexpeel/hex_mesh.h"
+#include "hexpeel/quad_surface.h"
+
+#include <nlohmann/json.hpp>
+
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace hexpeel {
+
+/// Verdict's hex scaled Jacobian (verdict v_hex_scaled_jacobian): the minimum over the 8 corner
+/// Jacobians and the centre (principal axes) Jacobian, each divided by its three column lengths.
+/// A zero-length edge or axis makes the hex degenerate: the value is then
+/// `kDegenerateScaledJacobian` (Verdict returns VERDICT_DBL_MAX; we count those as <= 0).
+inline constexpr double kDegenerateScaledJacobian = -2.0;
+double scaled_jacobian(const std::array<Vec3, 8>& corners);
+
+struct QualityParams {
+  int histogram_bins = 20;   ///< bins over [-1, 1] (1..1000)
+  int worst_count = 10;      ///< how many worst hexes to list (0..1000)
+  double boundary_tolerance = 1e-6;  ///< relative to the surface's bbox diagonal, for --surface
+};
+
+struct WorstHex {
+  int32_t hex = -1;
+  double scaled_jacobian = 0.0;
+  Vec3 centroid = Vec3::Zero();
+};
+
+struct QualityReport {
+  int32_t hexes = 0;
+  int32_t points = 0;
+  // scaled Jacobian
+  double sj_min = 0.0, sj_mean = 0.0, sj_max = 0.0;
+  int32_t sj_count_nonpositive = 0;  ///< SJ <= 0, degenerate hexes included
+  int32_t sj_degenerate = 0;         ///< zero-length edge or axis
+  std::vector<int32_t> histogram;    ///< histogram_bins counts over [-1, 1]; degenerate in bin 0
+  std::vector<WorstHex> worst;       ///< worst first, ties by id
+  std::vector<double> per_hex_sj;    ///< one value per hex
+  // topology
+  int32_t singular_edges_interior = 0;  ///< interior edges with valence != 4
+  int32_t singular_edges_boundary = 0;  ///< boundary edges with other than 2 hexes
+  int32_t vertices = 0, edges = 0, faces = 0;  ///< of the complex (used points only)
+  int32_t boundary_faces = 0;
+  int64_t euler_characteristic = 0;     ///< V - E + F - C
+  bool faces_manifold = true;           ///< every face used by one or two hexes
+  bool is_ball = false;                 ///< chi = 1, manifold faces, boundary a single sphere
+  std::string topology_message;         ///< why not a ball, when not
+  // boundary vs surface (when a surface was given)
+  std::optional<bool> boundary_matches_surface;
+  std::string boundary_message;         ///< first difference found, when not matching
+};
+
+/// Computes the full report. `surface` (optional) is compared with the mesh boundary: positions
+/// within tolerance, same set of quads up to rotation and reversal.
+QualityReport run_quality(const HexMesh& mesh, const QualityParams& params = {},
+                          const QuadSurface* surface = nullptr, const Context& ctx = {});
+
+/// The report as JSON: hexes, points, scaled_jacobian{min,mean,max,count_nonpositive,degenerate,
+/// histogram{lo,hi,counts},worst[{id,sj,centroid}]}, singular_edges{interior,boundary},
+/// euler_characteristic, is_ball, topology_message, boundary_matches_surface (when given).
+nlohmann::json to_json(const QualityReport& report);
+
+/// Multi-line human-readable text of the report.
+std::string to_text(const QualityReport& report);
+
+}  // namespace hexpeel

@@ -1,0 +1,66 @@
+// QuadSurface helpers: half-edge adjacency in one pass, quad normals, enclosed volume.
+#include "hexpeel/quad_surface.h"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+
+namespace hexpeel {
+
+QuadAdjacency build_adjacency(const QuadSurface& surface) {
+  const int32_t nq = surface.num_quads();
+  // Sort half-edges by their undirected key; runs of equal keys are the edges.
+  struct Item { int32_t lo, hi, he; };
+  std::vector<Item> items;
+  items.reserve(4 * static_cast<size_t>(nq));
+  for (int32_t q = 0; q < nq; ++q)
+    for (int k = 0; k < 4; ++k) {
+      int32_t a = surface.quads[q][k], b = surface.quads[q][(k + 1) & 3];
+      items.push_back({std::min(a, b), std::max(a, b), 4 * q + k});
+    }
+  std::sort(items.begin(), items.end(), [](const Item& x, const Item& y) {
+    return std::tie(x.lo, x.hi, x.he) < std::tie(y.lo, y.hi, y.he);
+  });
+  QuadAdjacency adj;
+  adj.opposite.assign(items.size(), -1);
+  for (size_t i = 0; i < items.size();) {
+    size_t j = i;
+    while (j < items.size() && items[j].lo == items[i].lo && items[j].hi == items[i].hi) ++j;
+    if (j - i == 2) {
+      adj.opposite[items[i].he] = items[i + 1].he;
+      adj.opposite[items[i + 1].he] = items[i].he;
+    }
+    i = j;
+  }
+  return adj;
+}
+
+Vec3 quad_normal(const QuadSurface& surface, int32_t q) {
+  const Quad& f = surface.quads[q];
+  const auto& p = surface.points;
+  Vec3 n = (p[f[2]] - p[f[0]]).cross(p[f[3]] - p[f[1]]);
+  double len = n.norm();
+  return len > 0 ? Vec3(n / len) : Vec3::Zero();
+}
+
+Vec3 quad_centroid(const QuadSurface& surface, int32_t q) {
+  const Quad& f = surface.quads[q];
+  const auto& p = surface.points;
+  return 0.25 * (p[f[0]] + p[f[1]] + p[f[2]] + p[f[3]]);
+}
+
+double signed_volume(const QuadSurface& surface) {
+  // Split each quad into two triangles fanned from corner 0; sum tetrahedra against the origin,
+  // offset by the first point to limit cancellation.
+  if (surface.points.empty()) return 0.0;
+  const Vec3 o = surface.points[0];
+  double vol = 0.0;
+  for (const Quad& f : surface.quads) {
+    Vec3 a = surface.points[f[0]] - o, b = surface.points[f[1]] - o, c = surface.points[f[2]] - o,
+         d = surface.points[f[3]] - o;
+    vol += a.dot(b.cross(c)) + a.dot(c.cross(d));
+  }
+  return vol / 6.0;
+}
+
+}  // namespace hexpeel

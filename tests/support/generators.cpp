@@ -1,0 +1,2 @@
+// Generators of valid quad surfaces (see generators.h).
+#include "support/generators.h"
