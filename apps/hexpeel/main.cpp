@@ -1,2 +1,239 @@
-// hexpeel command line (being written).
-int main() { return 0; }
+// hexpeel command line: the only code that parses argv, prints, or picks file names.
+//
+//   hexpeel check IN [--sharp-angle DEG] [--json FILE]
+//   hexpeel mesh IN -o OUT [--report FILE] [--dump-stuck FILE] [--sharp-angle DEG]
+//                [--time-limit S] [--quiet]
+//   hexpeel quality MESH [--surface IN] [--json FILE]
+//
+// Exit codes: 0 success, 1 usage error, 2 bad input or file problem, 3 meshing failed (stuck),
+// 4 internal error (a bug: please report it with the input).
+#include "hexpeel/diagnosis.h"
+#include "hexpeel/io.h"
+#include "hexpeel/pipeline.h"
+#include "hexpeel/quality.h"
+
+#include <CLI/CLI.hpp>
+
+#include <chrono>
+#include <cstdio>
+#include <exception>
+#include <iostream>
+#include <string>
+#include <unistd.h>
+
+namespace {
+
+using namespace hexpeel;
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+int report_error(const Status& s) {
+  std::fprintf(stderr, "hexpeel: error: %s\n", to_string(s).c_str());
+  return exit_code(s);
+}
+
+/// Progress on stderr: one line, updated at most every 0.25 s, shown once a run has taken
+/// more than a second (short runs stay quiet).
+struct Progress {
+  bool enabled = true;
+  bool tty = isatty(fileno(stderr)) != 0;
+  Clock::time_point start = Clock::now(), last = start;
+  bool shown = false;
+
+  void operator()(std::string_view stage, double fraction) {
+    if (!enabled) return;
+    auto now = Clock::now();
+    if (std::chrono::duration<double>(now - start).count() < 1.0) return;
+    if (std::chrono::duration<double>(now - last).count() < 0.25 && fraction < 1.0) return;
+    last = now;
+    std::fprintf(stderr, "%s%-16.*s %5.1f%%  %6.1fs%s", tty ? "\r" : "",
+                 static_cast<int>(stage.size()), stage.data(), 100.0 * fraction,
+                 std::chrono::duration<double>(now - start).count(), tty ? "" : "\n");
+    std::fflush(stderr);
+    shown = true;
+  }
+  void finish() {
+    if (shown && tty) std::fprintf(stderr, "\n");
+    shown = false;
+  }
+};
+
+Context make_context(Progress* progress, bool quiet) {
+  Context ctx;
+  ctx.log = [quiet](LogLevel level, std::string_view msg) {
+    if (quiet && level != LogLevel::warning) return;
+    if (level == LogLevel::debug) return;
+    std::fprintf(stderr, "hexpeel: %s%.*s\n", level == LogLevel::warning ? "warning: " : "",
+                 static_cast<int>(msg.size()), msg.data());
+  };
+  if (progress) ctx.progress = [progress](std::string_view s, double f) { (*progress)(s, f); };
+  return ctx;
+}
+
+int cmd_check(const std::string& in, double sharp_angle, const std::string& json_out) {
+  PolygonSoup soup;
+  Status st = read_surface(in, soup);
+  if (!st.ok()) return report_error(st);
+  SurfaceDiagnosis d = diagnose_surface(soup, sharp_angle, make_context(nullptr, false));
+  std::printf("%s", to_text(d).c_str());
+  if (!json_out.empty()) {
+    Status w = write_text_file(json_out, to_json(d).dump(2) + "\n");
+    if (!w.ok()) return report_error(w);
+  }
+  if (!d.status.ok()) {
+    std::fprintf(stderr, "hexpeel: %s: cannot be meshed: %s\n", in.c_str(), to_string(d.status).c_str());
+    return exit_code(d.status);
+  }
+  std::printf("verdict: %s can be given to the mesher\n", in.c_str());
+  return 0;
+}
+
+int cmd_mesh(const std::string& in, const std::string& out, const std::string& report,
+             const std::string& dump_stuck, const MeshParams& params, bool quiet) {
+  if (!is_hex_mesh_extension(out))
+    return report_error(Status::error(StatusCode::unsupported_format,
+                                      "output '" + out + "': use .vtk, .vtu, .mesh or .msh"));
+  if (!dump_stuck.empty() && !is_surface_extension(dump_stuck))
+    return report_error(Status::error(StatusCode::unsupported_format,
+                                      "--dump-stuck '" + dump_stuck + "': use .obj or .off"));
+  Progress progress;
+  progress.enabled = !quiet;
+  Context ctx = make_context(&progress, quiet);
+  auto t = Clock::now();
+  PolygonSoup soup;
+  Status st = read_surface(in, soup);
+  const double read_s = seconds_since(t);
+  if (!st.ok()) return report_error(st);
+
+  MeshResult r = run_mesh(soup, params, ctx);
+  progress.finish();
+  double write_s = 0.0;
+  if (r.status.ok()) {
+    t = Clock::now();
+    Status w = write_hex_mesh(out, r.mesh);
+    write_s = seconds_since(t);
+    if (!w.ok()) r.status = w;
+  }
+  if (!report.empty()) {
+    nlohmann::json j = to_json(r);
+    j["timings_s"]["read"] = read_s;
+    j["timings_s"]["write"] = write_s;
+    Status w = write_text_file(report, j.dump(2) + "\n");
+    if (!w.ok()) return report_error(w);
+  }
+  if (!r.status.ok()) {
+    if (r.status.code == StatusCode::stuck && !dump_stuck.empty() && r.stuck_surface.num_quads() > 0) {
+      Status w = write_surface(dump_stuck, r.stuck_surface);
+      if (!w.ok()) report_error(w);
+      else std::fprintf(stderr, "hexpeel: stuck surface written to %s\n", dump_stuck.c_str());
+    }
+    return report_error(r.status);
+  }
+  if (!quiet) {
+    const QualityReport& q = r.quality;
+    std::printf("%s: %d quads, %d chords -> %s: %d hexes in %.2f s\n", in.c_str(),
+                r.diagnosis.validation.surface.num_quads(), r.diagnosis.chord_stats.count,
+                out.c_str(), q.hexes,
+                read_s + r.timings.check_s + r.timings.elimination_s + r.timings.reconstruction_s +
+                    r.timings.placement_s + r.timings.quality_s + write_s);
+    std::printf("scaled Jacobian min %.4f mean %.4f max %.4f, %d hexes <= 0; "
+                "singular edges: %d interior, %d boundary\n",
+                q.sj_min, q.sj_mean, q.sj_max, q.sj_count_nonpositive, q.singular_edges_interior,
+                q.singular_edges_boundary);
+    if (q.sj_count_nonpositive > 0)
+      std::printf("note: interior vertices are placed by a harmonic solve only (no untangling "
+                  "yet); %d hexes are inverted or degenerate\n", q.sj_count_nonpositive);
+  }
+  return 0;
+}
+
+int cmd_quality(const std::string& mesh_path, const std::string& surface_path,
+                const std::string& json_out) {
+  HexMesh mesh;
+  int64_t others = 0;
+  Status st = read_hex_mesh(mesh_path, mesh, &others);
+  if (!st.ok()) return report_error(st);
+  if (others > 0)
+    std::fprintf(stderr, "hexpeel: warning: %s: %lld non-hex cells ignored\n", mesh_path.c_str(),
+                 static_cast<long long>(others));
+  QuadSurface surface;
+  bool have_surface = !surface_path.empty();
+  if (have_surface) {
+    PolygonSoup soup;
+    st = read_surface(surface_path, soup);
+    if (!st.ok()) return report_error(st);
+    ValidationResult v = run_validation(soup, {}, make_context(nullptr, false));
+    if (!v.status.ok()) return report_error(v.status);
+    surface = std::move(v.surface);
+    // compare against the surface as given (validation may have dropped unused vertices only)
+  }
+  QualityReport q = run_quality(mesh, {}, have_surface ? &surface : nullptr);
+  std::printf("%s", to_text(q).c_str());
+  if (!json_out.empty()) {
+    Status w = write_text_file(json_out, to_json(q).dump(2) + "\n");
+    if (!w.ok()) return report_error(w);
+  }
+  bool ok = q.sj_count_nonpositive == 0 && q.is_ball && q.boundary_matches_surface.value_or(true);
+  return ok ? 0 : 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"hexpeel: fill a closed genus-0 quad surface with hexahedra, keeping the surface"};
+  app.set_version_flag("--version", "hexpeel 0.1.0");
+  app.require_subcommand(1);
+
+  std::string in, out, report, dump_stuck, json_out, surface;
+  double sharp_angle = 60.0;
+  bool quiet = false;
+  MeshParams params;
+
+  auto* check = app.add_subcommand("check", "Diagnose a quad surface: validity, chords, sharp edges. "
+                                            "Exit 0 only if it can be given to the mesher.");
+  check->add_option("IN", in, "surface file (.obj .off .ply .mesh .msh .vtk)")->required();
+  check->add_option("--sharp-angle", sharp_angle, "deviation from flat (degrees) above which an edge is sharp")
+      ->check(CLI::Range(0.0, 180.0))->capture_default_str();
+  check->add_option("--json", json_out, "also write the diagnosis as JSON");
+
+  auto* mesh = app.add_subcommand("mesh", "Fill a quad surface with hexes by dual cycle elimination.");
+  mesh->add_option("IN", in, "surface file (.obj .off .ply .mesh .msh .vtk)")->required();
+  mesh->add_option("-o,--output", out, "hex mesh to write (.vtk .vtu .mesh .msh)")->required();
+  mesh->add_option("--report", report, "write a JSON report: quality, chords, steps, status, timings");
+  mesh->add_option("--dump-stuck", dump_stuck, "when elimination gets stuck, write the surface it stopped at (.obj .off)");
+  mesh->add_option("--sharp-angle", sharp_angle, "deviation from flat (degrees) above which an edge is sharp")
+      ->check(CLI::Range(0.0, 180.0))->capture_default_str();
+  mesh->add_option("--time-limit", params.elimination.time_limit_s,
+                   "give up elimination after this many seconds (0 = no limit)")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
+  mesh->add_flag("-q,--quiet", quiet, "print only warnings and errors");
+
+  auto* quality = app.add_subcommand("quality", "Report the quality of any hex mesh (.vtk .vtu .mesh .msh).");
+  quality->add_option("MESH", in, "hex mesh file")->required();
+  quality->add_option("--surface", surface, "also check that the mesh boundary equals this surface");
+  quality->add_option("--json", json_out, "also write the report as JSON");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 1;
+  }
+  try {
+    if (*check) return cmd_check(in, sharp_angle, json_out);
+    if (*mesh) {
+      params.sharp_angle_deg = sharp_angle;
+      return cmd_mesh(in, out, report, dump_stuck, params, quiet);
+    }
+    if (*quality) return cmd_quality(in, surface, json_out);
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "hexpeel: error: out of memory\n");
+    return 4;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "hexpeel: %s\n", e.what());
+    return 4;
+  }
+  return 1;
+}

@@ -1,0 +1,130 @@
+// run_mesh: the stages in order, each timed; the first failure stops the run with its status.
+//
+// The output mesh numbers its vertices as the input surface does (vertex i of the output is
+// input vertex i, at the same position), then the interior vertices in construction order.
+#include "hexpeel/pipeline.h"
+
+#include <chrono>
+
+namespace hexpeel {
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// Renumbers the complex's vertices: input surface vertices first (by input id), then interior
+/// vertices by creation order.
+HexMesh renumber(const HexMesh& mesh, const HexComplex& complex, int32_t surface_points) {
+  const int32_t nv = complex.num_vertices;
+  std::vector<int32_t> to_new(nv, -1);
+  int32_t next = surface_points;
+  for (int32_t v = 0; v < nv; ++v)
+    to_new[v] = complex.input_vertex[v] >= 0 ? complex.input_vertex[v] : next++;
+  HexMesh out;
+  out.points.resize(nv);
+  for (int32_t v = 0; v < nv; ++v) out.points[to_new[v]] = mesh.points[v];
+  out.hexes.reserve(mesh.hexes.size());
+  for (const Hex& h : mesh.hexes) {
+    Hex t;
+    for (int k = 0; k < 8; ++k) t[k] = to_new[h[k]];
+    out.hexes.push_back(t);
+  }
+  return out;
+}
+
+}  // namespace
+
+MeshResult run_mesh(const PolygonSoup& soup, const MeshParams& params, const Context& ctx) {
+  MeshResult r;
+  auto t = std::chrono::steady_clock::now();
+  r.diagnosis = diagnose_surface(soup, params.sharp_angle_deg, ctx, params.validation);
+  r.timings.check_s = seconds_since(t);
+  if (!r.diagnosis.status.ok()) {
+    r.status = r.diagnosis.status;
+    return r;
+  }
+  const QuadSurface& surface = r.diagnosis.validation.surface;
+
+  t = std::chrono::steady_clock::now();
+  EliminationState state(surface, r.diagnosis.chords, r.diagnosis.edges);
+  r.plan = run_elimination(state, params.elimination, ctx);
+  r.timings.elimination_s = seconds_since(t);
+  if (!r.plan.status.ok()) {
+    r.status = r.plan.status;
+    if (r.plan.status.code == StatusCode::stuck) r.stuck_surface = state.current_surface();
+    return r;
+  }
+
+  t = std::chrono::steady_clock::now();
+  ReconstructionResult rec = run_reconstruction(surface, r.plan, params.reconstruction, ctx, &state);
+  r.reconstruction = rec.stats;
+  r.timings.reconstruction_s = seconds_since(t);
+  if (!rec.status.ok()) {
+    r.status = rec.status;
+    return r;
+  }
+
+  t = std::chrono::steady_clock::now();
+  PlacementResult placed = run_placement(surface, rec.complex, params.placement, ctx);
+  r.placement = placed.stats;
+  r.timings.placement_s = seconds_since(t);
+  if (!placed.status.ok()) {
+    r.status = placed.status;
+    return r;
+  }
+  r.mesh = renumber(placed.mesh, rec.complex, surface.num_points());
+
+  t = std::chrono::steady_clock::now();
+  r.quality = run_quality(r.mesh, params.quality, &surface, ctx);
+  r.timings.quality_s = seconds_since(t);
+  if (!r.quality.is_ball || r.quality.boundary_matches_surface != true) {
+    r.status = Status::error(StatusCode::internal_error,
+                             "the constructed complex failed its final check: " +
+                                 r.quality.topology_message + " " + r.quality.boundary_message);
+  }
+  return r;
+}
+
+nlohmann::json to_json(const MeshResult& r) {
+  nlohmann::json j = r.status.ok() ? to_json(r.quality) : nlohmann::json::object();
+  j["status"] = std::string(to_string(r.status.code));
+  j["message"] = r.status.message;
+  j["input"] = to_json(r.diagnosis);
+  const ChordStats& cs = r.diagnosis.chord_stats;
+  j["chords"] = {{"count", cs.count},
+                 {"min_length", cs.min_length},
+                 {"mean_length", cs.mean_length},
+                 {"max_length", cs.max_length},
+                 {"self_intersecting", cs.self_intersecting}};
+  j["steps"] = r.plan.stats.steps;
+  j["plan"] = {{"steps", r.plan.stats.steps},
+               {"flat_steps", r.plan.stats.flat_steps},
+               {"predicted_hexes", r.plan.stats.predicted_hexes},
+               {"feasibility_tests", r.plan.stats.feasibility_tests}};
+  if (r.plan.status.code == StatusCode::stuck) {
+    nlohmann::json reasons = nlohmann::json::object();
+    for (size_t i = 0; i < r.plan.stuck.reasons.size(); ++i)
+      if (r.plan.stuck.reasons[i] > 0)
+        reasons[std::string(to_string(static_cast<Infeasible>(i)))] = r.plan.stuck.reasons[i];
+    j["stuck"] = {{"quads_left", r.plan.stuck.quads_left},
+                  {"chords_left", r.plan.stuck.chords_left},
+                  {"reasons", reasons}};
+  }
+  j["reconstruction"] = {{"hexes", r.reconstruction.hexes},
+                         {"slit_edges", r.reconstruction.slit_edges},
+                         {"steps_verified", r.reconstruction.steps_verified}};
+  j["placement"] = {{"method", "harmonic"},
+                    {"interior_vertices", r.placement.interior_vertices},
+                    {"coincident_pairs_separated", r.placement.coincident_pairs - r.placement.coincident_after},
+                    {"coincident_pairs_left", r.placement.coincident_after},
+                    {"nonpositive_hexes", r.placement.nonpositive_hexes}};
+  j["timings_s"] = {{"check", r.timings.check_s},
+                    {"elimination", r.timings.elimination_s},
+                    {"reconstruction", r.timings.reconstruction_s},
+                    {"placement", r.timings.placement_s},
+                    {"quality", r.timings.quality_s}};
+  return j;
+}
+
+}  // namespace hexpeel
