@@ -1,11 +1,12 @@
 // Reading and writing files. The format is chosen by the file extension (case-insensitive).
 //
 // Surfaces (read): .obj  .off  .ply (ASCII, binary little/big endian)  .mesh (MEDIT, Quadrilaterals)
-//                  .msh (Gmsh 2.2 and 4.1, ASCII and binary; quad elements)  .vtk (legacy, POLYDATA
-//                  POLYGONS or UNSTRUCTURED_GRID cells)
+//                  .msh (Gmsh 2.2 and 4.1, ASCII and binary; quad elements)  .vtk (legacy, ASCII or
+//                  binary, POLYDATA POLYGONS or UNSTRUCTURED_GRID cells)  .vtu (its 2D cells)
 // Surfaces (write): .obj .off (for dumping intermediate surfaces)
 // Hex meshes (read and write): .vtk (legacy ASCII)  .vtu (VTK XML, ASCII)  .mesh (MEDIT)
-//                              .msh (Gmsh 4.1 ASCII)
+//                              .msh (Gmsh 4.1 ASCII). Reading also takes what the surface readers
+//                              take: binary .vtk, binary/appended/zlib .vtu, Gmsh 2.2 and binary.
 //
 // Readers never crash on any bytes: every problem comes back as a Status naming the line (or
 // byte offset) and what was expected. Writers write to a temporary file beside the target and
