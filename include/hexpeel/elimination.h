@@ -1,172 +1,22 @@
-// Elimination: dual cycle (chord) elimination down to a single cube (paper sections 3.1-3.4).
-//
-// Two layers:
-//  * EliminationState — the undoable engine. It holds the intermediate surface (input quads keep
-//    their ids and corner order; only vertices merge), answers feasibility and side questions,
-//    collapses a chord and undoes the last collapse in O(chord length). Search strategies are
-//    built on it.
-//  * run_elimination — the greedy order of Müller-Hannemann with the paper's weights; it returns
-//    an EliminationPlan that reconstruction replays in reverse.
+// Elimination: dual cycle (chord) elimination down to a single cube (paper sections 3.1-3.4),
+// greedy in the order of the rules of order.h. Returns an EliminationPlan that reconstruction
+// replays in reverse.
 #pragma once
 
-#include "hexpeel/chords.h"
 #include "hexpeel/context.h"
-#include "hexpeel/quad_surface.h"
+#include "hexpeel/elimination_state.h"
+#include "hexpeel/order.h"
 #include "hexpeel/status.h"
 
 #include <array>
-#include <cstdint>
 #include <string>
 #include <vector>
 
 namespace hexpeel {
 
-/// Why a chord cannot be eliminated right now (paper 3.2 plus our bookkeeping limits).
-enum class Infeasible : int8_t {
-  none = 0,
-  self_intersecting,   ///< the chord passes through a quad twice
-  no_connected_side,   ///< neither side's quads form one edge-connected set
-  degenerate_face,     ///< a remaining quad would get a repeated corner
-  nonmanifold_edge,    ///< an edge would be used by other than two quads
-  low_valence,         ///< a vertex would have fewer than three edges
-  face_pair,           ///< two quads would share two vertices that are not an edge of both
-  pinched_vertex,      ///< the quads around a merged vertex would form several fans
-  euler,               ///< the collapse would change the Euler characteristic
-  too_few_chords,      ///< only the cube's three chords are left
-};
-std::string_view to_string(Infeasible why);
-
-/// Accumulated sharpness of an edge of the intermediate surface (weights add when edges merge).
-struct EdgeWeight {
-  int32_t sharp = 0;    ///< number of input sharp edges merged into this one
-  int32_t convex = 0;   ///< ... of which convex
-  int32_t concave = 0;  ///< ... of which concave
-  double bend = 0.0;    ///< summed signed bend in degrees (>0 convex), for zero-volume tests
-};
-
-/// Per-side and flatness weights of a chord (paper 3.4 and 5.1), divided by its length.
-struct ChordWeights {
-  int32_t length = 0;
-  std::array<double, 2> sharp{};    ///< [left, right]: sharp parallel edges / length
-  std::array<double, 2> convex{};   ///< convex sharp parallel edges / length
-  std::array<double, 2> concave{};  ///< concave sharp parallel edges / length
-  int32_t crossing_sharp = 0;       ///< sharp edges the chord crosses; 0 = a flat chord
-};
-
-/// What reconstruction needs for one chord quad g of an eliminated chord: the quad h across g's
-/// parallel edge on side s (local edge `es` of g) and the local edge j of h that g collapses into.
-struct ChordQuadRecord {
-  int32_t quad = -1;  ///< g
-  int8_t es = 0;      ///< local edge of g parallel to the chord, on side s
-  int32_t h = -1;     ///< quad across that edge (on side s, never a chord quad)
-  int8_t j = 0;       ///< local edge of h shared with g before the collapse
-};
-
-struct PlanStep {
-  int32_t chord = -1;                 ///< id in the input ChordSet
-  int8_t side = 0;                    ///< 0 = left, 1 = right of the chord's walking direction
-  bool concave = false;               ///< reconstructed by intrusion (Kremer 5.3) — not yet used
-  std::vector<int32_t> side_quads;    ///< quads on side s (sorted ids); |side| hexes
-  std::vector<ChordQuadRecord> chord_quads;  ///< in chord walking order
-  double priority = 0.0;              ///< the weight that chose this step
-  bool flat = false;                  ///< a flat chord (eliminated only because nothing else was)
-};
-
-/// The intermediate surface, undoable. Not thread-safe (uses scratch buffers).
-class EliminationState {
- public:
-  /// `surface` must be valid (closed, manifold, genus 0, outward); `chords` its chord set;
-  /// `edges` its edge classification.
-  EliminationState(const QuadSurface& surface, const ChordSet& chords, const EdgeGeometry& edges);
-
-  int32_t alive_quads() const { return alive_quads_; }
-  int32_t alive_chords() const { return alive_chords_; }
-  bool quad_alive(int32_t q) const { return quad_alive_[q] != 0; }
-  bool chord_alive(int32_t c) const { return chord_len_[c] > 0; }
-  int32_t chord_length(int32_t c) const { return chord_len_[c]; }
-  int32_t num_chords() const { return static_cast<int32_t>(chords_->chords.size()); }
-  int32_t steps_applied() const { return static_cast<int32_t>(marks_.size()); }
-
-  /// The current passages of chord c (input steps whose quad is alive), in walking order.
-  void chord_steps(int32_t c, std::vector<ChordStep>& out) const;
-  /// Current corners of quad q (merged vertex representatives, input corner order).
-  Quad corners(int32_t q) const;
-  /// Current opposite half-edge of half-edge 4q+k.
-  int32_t opposite(int32_t he) const { return opp_[he]; }
-  const EdgeWeight& edge_weight(int32_t he) const { return weight_[he]; }
-
-  ChordWeights weights(int32_t c) const;
-
-  /// Feasibility of eliminating chord c (3-connectivity by the local test of DESIGN.md, side
-  /// connectivity), and which sides are usable: sides[s] is true when side s is edge-connected
-  /// and its bookkeeping is possible.
-  struct Feasibility {
-    Infeasible why = Infeasible::none;
-    std::array<bool, 2> sides{};
-    bool ok() const { return why == Infeasible::none; }
-  };
-  Feasibility feasibility(int32_t c) const;
-
-  /// Only the local polyhedrality test of collapsing chord c (no side or chord-count checks);
-  /// exposed so tests can compare it with a brute-force 3-connectivity check.
-  Infeasible collapse_check(int32_t c) const;
-
-  /// Quads on side s of chord c (sorted ids), by a search that never enters the chord.
-  void side_region(int32_t c, int side, std::vector<int32_t>& out) const;
-
-  /// Collapses chord c, recording the step for side s (which must be usable). O(|c| + |side|).
-  PlanStep apply(int32_t c, int side);
-  /// Undoes the last apply. O(|c|).
-  void undo();
-
-  /// The current surface as a QuadSurface (points: positions of representatives) with the ids of
-  /// the alive input quads in `quad_ids`.
-  QuadSurface current_surface(std::vector<int32_t>* quad_ids = nullptr) const;
-
- private:
-  int32_t find(int32_t v) const;
-  bool side_usable(const std::vector<ChordStep>& steps, int side) const;
-  Infeasible collapse_test(const std::vector<ChordStep>& steps) const;
-  void mark_chord_quads(const std::vector<ChordStep>& steps) const;
-  bool is_marked(int32_t q) const { return cmark_[q] == cepoch_; }
-  void set_opp(int32_t he, int32_t value);
-  void set_weight(int32_t he, const EdgeWeight& w);
-
-  const QuadSurface* surface_;  ///< the input surface (outlives the state)
-  const ChordSet* chords_;      ///< its chords (outlives the state)
-  std::vector<uint8_t> quad_alive_;   ///< per input quad
-  std::vector<int32_t> chord_len_;    ///< alive passages per chord; 0 = eliminated
-  std::vector<int32_t> opp_;          ///< opposite half-edge in the current surface
-  std::vector<EdgeWeight> weight_;    ///< per half-edge, equal on both halves of an edge
-  std::vector<int32_t> uf_parent_;    ///< union-find over input vertices (no path compression)
-  std::vector<int8_t> uf_rank_;
-  int32_t alive_quads_ = 0, alive_chords_ = 0;
-
-  // Undo log: every write to opp_/weight_/uf_/quad_alive_/chord_len_ records the old value.
-  struct LogEntry {
-    enum Kind : int8_t { opp, weight, parent, rank, quad, chord } kind;
-    int32_t index;
-    int32_t old_int;
-    EdgeWeight old_weight;
-  };
-  std::vector<LogEntry> log_;
-  std::vector<size_t> marks_;  ///< log size before each applied step
-
-  // scratch (mutable: queries are logically const)
-  mutable std::vector<int32_t> stamp_;   ///< BFS visit marks (== epoch_)
-  mutable int32_t epoch_ = 0;
-  mutable std::vector<int32_t> cmark_;   ///< chord-quad marks (== cepoch_)
-  mutable int32_t cepoch_ = 0;
-  mutable std::vector<int32_t> local_parent_;  ///< collapse_test's trial merges (-1 = root)
-  mutable std::vector<int32_t> chord_hits_;    ///< collapse_test: crossings per other chord
-  mutable std::vector<ChordStep> scratch_steps_;
-};
-
-enum class Method { original };  // Kremer et al.'s rules arrive with their own issue
-
 struct EliminationParams {
-  double sharp_angle_deg = 60.0;  ///< deviation from flat (degrees, 0..180) above which an edge is sharp
-  double time_limit_s = 0.0;      ///< stop with `stuck` after this long; 0 = no limit
+  OrderParams order;          ///< ranking and side rules
+  double time_limit_s = 0.0;  ///< stop with `stuck` after this long; 0 = no limit
 };
 
 struct StuckReport {

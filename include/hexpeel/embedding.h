@@ -13,7 +13,8 @@ namespace hexpeel {
 
 struct PlacementParams {
   /// Interior vertices are the harmonic (uniform graph Laplacian) interpolation of the fixed
-  /// boundary over the complex's edges, solved exactly by sparse Cholesky.
+  /// boundary over the complex's edges, solved by conjugate gradients to this relative residual.
+  double solver_tolerance = 1e-10;
   double min_separation = 1e-9;  ///< relative to the bbox diagonal: closer interior pairs are reported
 };
 

@@ -1,16 +1,16 @@
 // Initial placement of interior vertices: harmonic interpolation of the boundary.
 //
 // Boundary vertices are copied from the input surface. Interior vertices solve the uniform graph
-// Laplacian over the complex's edges with the boundary fixed (a discrete harmonic map), by a
-// sparse Cholesky factorization (Eigen SimplicialLDLT). It is a start for the untangler, not a
-// quality placement: concave shapes get inverted hexes. Coincident vertices are counted, since a
-// placement that collapses vertices makes a valid complex look broken to point-merging readers.
+// Laplacian over the complex's edges with the boundary fixed (a discrete harmonic map) by
+// conjugate gradients. It is a start for the untangler, not a quality placement: concave shapes
+// get inverted hexes. Coincident vertices are separated, since a placement that collapses
+// vertices makes a valid complex look broken to point-merging readers.
 #include "hexpeel/embedding.h"
 #include "hexpeel/quality.h"
 
 #include <Eigen/Geometry>
 #include <Eigen/Sparse>
-#include <Eigen/SparseCholesky>
+#include <Eigen/IterativeLinearSolvers>
 
 #include <algorithm>
 #include <chrono>
@@ -80,12 +80,22 @@ PlacementResult run_placement(const QuadSurface& surface, const HexComplex& comp
     for (int32_t i = 0; i < nu; ++i) trip.emplace_back(i, i, deg[i]);
     Eigen::SparseMatrix<double> L(nu, nu);
     L.setFromTriplets(trip.begin(), trip.end());
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(L);
-    if (solver.info() != Eigen::Success) {
-      res.status = Status::error(StatusCode::internal_error, "placement: Laplacian factorization failed");
-      return res;
+    // Conjugate gradients (diagonal preconditioner): a direct factorization of a 3D Laplacian
+    // fills in badly (minutes and gigabytes at 100k hexes); CG needs only the matrix. Single
+    // threaded, hence deterministic.
+    Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper> solver;
+    solver.setTolerance(params.solver_tolerance);
+    solver.setMaxIterations(std::max<int32_t>(1000, 10 * nu));
+    solver.compute(L);
+    Eigen::MatrixXd x(nu, 3);
+    for (int d = 0; d < 3; ++d) {
+      x.col(d) = solver.solve(rhs.col(d));
+      if (solver.info() != Eigen::Success) {
+        res.status = Status::error(StatusCode::internal_error,
+                                   "placement: the Laplacian solve did not converge");
+        return res;
+      }
     }
-    Eigen::MatrixXd x = solver.solve(rhs);
     for (int32_t v = 0; v < nv; ++v)
       if (unknown[v] >= 0) res.mesh.points[v] = x.row(unknown[v]).transpose();
   }

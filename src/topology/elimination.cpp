@@ -1,10 +1,8 @@
-// Greedy dual cycle elimination in Müller-Hannemann's order (paper section 3.4).
+// Greedy dual cycle elimination (paper section 3.4) in the order of an OrderPolicy.
 //
-// Every step rates the remaining simple chords by their side weights (sharp parallel edges per
-// chord length), takes the best feasible one and collapses it on its heavier usable side; flat
-// chords (crossing no sharp edge) come last, only when nothing else is feasible. Ties: equal
-// weight -> shorter chord -> smaller chord id; equal side weights -> the side with fewer quads
-// (fewer hexes), then the left side. Deterministic.
+// Every step ranks the remaining chords by their quick keys, tests them for feasibility in that
+// order, rates feasible ones fully (re-queueing those whose full key is larger) and collapses
+// the first whose full key is still the smallest. Deterministic: keys end with the chord id.
 //
 // Input: a fresh EliminationState of a valid surface. Output: the plan, or `stuck` with the
 // reasons every remaining chord is infeasible.
@@ -17,26 +15,6 @@
 
 namespace hexpeel {
 namespace {
-
-struct Candidate {
-  int flat;        // 1 = flat chord (last resort)
-  double weight;   // larger first
-  int32_t length;  // shorter first
-  int32_t chord;   // smaller first
-  std::array<bool, 2> sides;  // sides the rating assumed usable
-
-  bool operator>(const Candidate& o) const {
-    return std::make_tuple(flat, -weight, length, chord) >
-           std::make_tuple(o.flat, -o.weight, o.length, o.chord);
-  }
-};
-
-Candidate rate(const ChordWeights& w, int32_t chord, std::array<bool, 2> sides) {
-  double best = -1.0;
-  for (int s = 0; s < 2; ++s)
-    if (sides[s]) best = std::max(best, w.sharp[s]);
-  return {w.crossing_sharp == 0 ? 1 : 0, best, w.length, chord, sides};
-}
 
 std::string stuck_text(const StuckReport& r) {
   std::string text = std::to_string(r.quads_left) + " quads and " + std::to_string(r.chords_left) +
@@ -69,43 +47,37 @@ EliminationPlan run_elimination(EliminationState& state, const EliminationParams
     }
 
   plan.stats.predicted_hexes = 1;
-  std::vector<int32_t> region;
+  const OrderPolicy policy(params.order);
   while (state.alive_chords() > 3) {
     if (params.time_limit_s > 0 &&
         std::chrono::duration<double>(clock::now() - t0).count() > params.time_limit_s) {
       plan.status = Status::error(StatusCode::stuck, "time limit reached during elimination");
       break;
     }
-    std::priority_queue<Candidate, std::vector<Candidate>, std::greater<>> heap;
+    // Min-heap on (key, is_full): a chord's full key is never smaller than its quick key.
+    using Entry = std::pair<Move, bool>;
+    auto later = [](const Entry& x, const Entry& y) {
+      return std::tie(x.first.key, x.second) > std::tie(y.first.key, y.second);
+    };
+    std::priority_queue<Entry, std::vector<Entry>, decltype(later)> heap(later);
     for (int32_t c = 0; c < nchords; ++c)
-      if (state.chord_alive(c)) heap.push(rate(state.weights(c), c, {true, true}));
+      if (state.chord_alive(c)) heap.push({policy.quick(state, c), false});
     bool chosen = false;
     while (!heap.empty()) {
-      Candidate cand = heap.top();
+      auto [move, is_full] = heap.top();
       heap.pop();
-      ++plan.stats.feasibility_tests;
-      auto f = state.feasibility(cand.chord);
-      if (!f.ok()) continue;
-      if (f.sides != cand.sides) {  // re-rate with the usable sides only
-        heap.push(rate(state.weights(cand.chord), cand.chord, f.sides));
+      if (!is_full) {
+        ++plan.stats.feasibility_tests;
+        auto f = state.feasibility(move.chord);
+        if (!f.ok()) continue;
+        heap.push({policy.full(state, move.chord, f.sides), true});
         continue;
       }
-      ChordWeights w = state.weights(cand.chord);
-      int side;
-      if (f.sides[0] && f.sides[1] && w.sharp[0] == w.sharp[1]) {
-        state.side_region(cand.chord, 0, region);
-        size_t left = region.size();
-        state.side_region(cand.chord, 1, region);
-        side = region.size() < left ? 1 : 0;
-      } else if (f.sides[0] && f.sides[1]) {
-        side = w.sharp[0] > w.sharp[1] ? 0 : 1;
-      } else {
-        side = f.sides[0] ? 0 : 1;
-      }
-      PlanStep step = state.apply(cand.chord, side);
-      step.priority = w.sharp[side];
-      step.flat = cand.flat != 0;
-      plan.stats.predicted_hexes += static_cast<int64_t>(step.side_quads.size());
+      PlanStep step = state.apply(move.chord, move.side);
+      step.concave = move.concave;
+      step.flat = move.flat;
+      step.priority = -move.key[1];
+      plan.stats.predicted_hexes += (move.concave ? -1 : 1) * static_cast<int64_t>(step.side_quads.size());
       plan.stats.flat_steps += step.flat;
       plan.steps.push_back(std::move(step));
       chosen = true;

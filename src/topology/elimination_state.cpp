@@ -8,7 +8,7 @@
 //
 // Assumes a valid input surface (closed, manifold, genus 0). Guarantees: quads keep their input
 // ids and corner order (invariant 1); apply() followed by undo() restores every array exactly.
-#include "hexpeel/elimination.h"
+#include "hexpeel/elimination_state.h"
 
 #include <algorithm>
 #include <functional>
@@ -140,6 +140,12 @@ void EliminationState::side_region(int32_t c, int side, std::vector<int32_t>& ou
     }
   }
   std::sort(out.begin(), out.end());
+}
+
+int32_t EliminationState::side_size(int32_t c, int side) const {
+  std::vector<int32_t> region;
+  side_region(c, side, region);
+  return static_cast<int32_t>(region.size());
 }
 
 bool EliminationState::side_usable(const std::vector<ChordStep>& steps, int side) const {
