@@ -2,10 +2,14 @@
 //
 //   hexpeel check IN [--sharp-angle DEG] [--json FILE]
 //   hexpeel mesh IN -o OUT [--report FILE] [--dump-stuck FILE] [--sharp-angle DEG]
-//                [--time-limit S] [--quiet]
+//                [--time-limit S] [--method original|kremer] [--no-zero-volume]
+//                [--no-enclosed] [--no-concave] [--no-false-positive] [--no-concave-waits]
+//                [--intrusion-fallback] [--pillow auto|all|none] [--no-untangle]
+//                [--no-optimize] [--quiet]
 //   hexpeel quality MESH [--surface IN] [--json FILE]
 //
-// Exit codes: 0 success, 1 usage error, 2 bad input or file problem, 3 meshing failed (stuck),
+// Exit codes: 0 success, 1 usage error, 2 bad input or file problem (for `quality`: also a mesh
+// with hexes of scaled Jacobian <= 0, not a ball, or not bounded by --surface), 3 meshing failed,
 // 4 internal error (a bug: please report it with the input).
 #include "hexpeel/diagnosis.h"
 #include "hexpeel/io.h"
@@ -84,7 +88,10 @@ int cmd_check(const std::string& in, double sharp_angle, const std::string& json
     if (!w.ok()) return report_error(w);
   }
   if (!d.status.ok()) {
-    std::fprintf(stderr, "hexpeel: %s: cannot be meshed: %s\n", in.c_str(), to_string(d.status).c_str());
+    std::printf("verdict: %s cannot be given to the mesher (%s)\n", in.c_str(),
+                std::string(to_string(d.status.code)).c_str());
+    std::fprintf(stderr, "hexpeel: error: %s: cannot be meshed: %s\n", in.c_str(),
+                 to_string(d.status).c_str());
     return exit_code(d.status);
   }
   std::printf("verdict: %s can be given to the mesher\n", in.c_str());
@@ -134,18 +141,32 @@ int cmd_mesh(const std::string& in, const std::string& out, const std::string& r
   }
   if (!quiet) {
     const QualityReport& q = r.quality;
-    std::printf("%s: %d quads, %d chords -> %s: %d hexes in %.2f s\n", in.c_str(),
+    std::printf("%s: %d quads, %d chords -> %s: %d hexes in %.2f s (method %s, %d concave "
+                "steps)\n", in.c_str(),
                 r.diagnosis.validation.surface.num_quads(), r.diagnosis.chord_stats.count,
                 out.c_str(), q.hexes,
                 read_s + r.timings.check_s + r.timings.elimination_s + r.timings.reconstruction_s +
-                    r.timings.placement_s + r.timings.quality_s + write_s);
+                    r.timings.pillow_s + r.timings.placement_s + r.timings.untangle_s + r.timings.quality_s + write_s,
+                std::string(to_string(r.method.method)).c_str(), r.plan.stats.concave_steps);
     std::printf("scaled Jacobian min %.4f mean %.4f max %.4f, %d hexes <= 0; "
                 "singular edges: %d interior, %d boundary\n",
                 q.sj_min, q.sj_mean, q.sj_max, q.sj_count_nonpositive, q.singular_edges_interior,
                 q.singular_edges_boundary);
-    if (q.sj_count_nonpositive > 0)
-      std::printf("note: interior vertices are placed by a harmonic solve only (no untangling "
-                  "yet); %d hexes are inverted or degenerate\n", q.sj_count_nonpositive);
+    if (r.pillow.forced > 0)
+      std::printf("forced configurations: %d (%d flat doublets, %d concave corners, %d fixed "
+                  "corners, %d collinear); pillow: %d hexes in the shrink set%s, %d new hexes\n",
+                  r.pillow.forced, r.pillow.flat_doublets, r.pillow.concave_corners,
+                  r.pillow.fixed_corners, r.pillow.collinear, r.pillow.shrink_set,
+                  r.pillow.whole_boundary ? " (whole boundary)" : "", r.pillow.new_hexes);
+    if (q.sj_count_nonpositive > 0) {
+      if (params.untangle.untangle)
+        std::printf("note: %d hexes are inverted or degenerate after untangling (%d corners are "
+                    "fixed by the boundary at det <= 0; try --pillow all)\n",
+                    q.sj_count_nonpositive, r.untangle.forced_nonpositive);
+      else
+        std::printf("note: interior vertices are placed by a harmonic solve only (--no-untangle); "
+                    "%d hexes are inverted or degenerate\n", q.sj_count_nonpositive);
+    }
   }
   return 0;
 }
@@ -176,8 +197,17 @@ int cmd_quality(const std::string& mesh_path, const std::string& surface_path,
     Status w = write_text_file(json_out, to_json(q).dump(2) + "\n");
     if (!w.ok()) return report_error(w);
   }
-  bool ok = q.sj_count_nonpositive == 0 && q.is_ball && q.boundary_matches_surface.value_or(true);
-  return ok ? 0 : 1;
+  // A mesh that fails the check is bad input (exit 2; 1 is kept for usage errors).
+  std::string why;
+  if (q.sj_count_nonpositive > 0)
+    why += std::to_string(q.sj_count_nonpositive) + " hexes have a scaled Jacobian <= 0; ";
+  if (!q.is_ball) why += "the hexes do not form a ball (" + q.topology_message + "); ";
+  if (!q.boundary_matches_surface.value_or(true))
+    why += "its boundary differs from " + surface_path + " (" + q.boundary_message + "); ";
+  if (why.empty()) return 0;
+  why.resize(why.size() - 2);
+  std::fprintf(stderr, "hexpeel: error: %s: %s\n", mesh_path.c_str(), why.c_str());
+  return 2;
 }
 
 }  // namespace
@@ -207,8 +237,56 @@ int main(int argc, char** argv) {
   mesh->add_option("--sharp-angle", sharp_angle, "deviation from flat (degrees) above which an edge is sharp")
       ->check(CLI::Range(0.0, 180.0))->capture_default_str();
   mesh->add_option("--time-limit", params.elimination.time_limit_s,
-                   "give up elimination after this many seconds (0 = no limit)")
+                   "--planner greedy: give up elimination after this many seconds (0 = no limit)")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
+  std::string planner = "search";
+  mesh->add_option("--planner", planner,
+                   "search: portfolio search over elimination orders (greedy, windowed backtracking, "
+                   "beam, restarts), never stuck where an order exists within the budget; "
+                   "greedy: one greedy pass in the order rules' order (the paper's method)")
+      ->check(CLI::IsMember({"search", "greedy"}))->capture_default_str();
+  mesh->add_option("--plan-budget", params.planner.budget_s,
+                   "wall-clock budget of the search (s); the search stops earlier when its "
+                   "strategies are done. A run that hits the budget may depend on machine speed")
+      ->check(CLI::PositiveNumber)->capture_default_str();
+  mesh->add_option("--seed", params.planner.seed, "seed of the search's randomized restarts")
+      ->capture_default_str();
+  std::string side_rule = "cost";
+  mesh->add_option("--side-rule", side_rule,
+                   "cost: the side with fewer quads (fewer hexes) unless the other side is clearly "
+                   "sharper (--side-threshold); heavier: the side with more sharp edges (paper 3.4)")
+      ->check(CLI::IsMember({"cost", "heavier"}))->capture_default_str();
+  mesh->add_option("--side-threshold", params.elimination.order.side_threshold,
+                   "--side-rule cost: sharp-weight difference (0..1) that makes the larger side win")
+      ->check(CLI::Range(0.0, 2.0))->capture_default_str();
+  std::string method = "kremer";
+  bool no_zero_volume = false, no_enclosed = false, no_concave = false, no_false_positive = false,
+       no_concave_waits = false;
+  mesh->add_option("--method", method, "elimination order: original (Müller-Hannemann) or kremer "
+                                       "(Kremer et al. 2013 rules)")
+      ->check(CLI::IsMember({"original", "kremer"}))->capture_default_str();
+  mesh->add_flag("--no-zero-volume", no_zero_volume, "kremer: do not postpone zero-volume chords (4.1)");
+  mesh->add_flag("--no-enclosed", no_enclosed, "kremer: do not make chords wait for enclosed chords (4.2)");
+  mesh->add_flag("--no-concave", no_concave, "kremer: no concave chords / intrusion (5.1-5.3)");
+  mesh->add_flag("--no-false-positive", no_false_positive,
+                 "kremer: accept concave chords whose side region is not flat (5.4)");
+  mesh->add_flag("--no-concave-waits", no_concave_waits,
+                 "kremer: concave chords do not wait for enclosed non-flat chords (5.4)");
+  bool strict_intrusion = false;
+  mesh->add_flag("--strict-intrusion", strict_intrusion,
+                 "fail with invalid_intrusion (exit 3) when a concave step cannot be intruded, "
+                 "instead of extruding it");
+  std::string pillow = "auto";
+  bool no_untangle = false, no_optimize = false;
+  mesh->add_option("--pillow", pillow,
+                   "pillow layer under the boundary: auto = only around forced configurations "
+                   "(hex corners the fixed boundary makes bad), all = whole boundary, none "
+                   "(default: auto)")
+      ->check(CLI::IsMember({"auto", "all", "none"}))->capture_default_str();
+  mesh->add_flag("--no-untangle", no_untangle,
+                 "keep the harmonic placement: no Winslow untangling (default: untangle)");
+  mesh->add_flag("--no-optimize", no_optimize,
+                 "skip the scaled-Jacobian optimization after untangling (default: optimize)");
   mesh->add_flag("-q,--quiet", quiet, "print only warnings and errors");
 
   auto* quality = app.add_subcommand("quality", "Report the quality of any hex mesh (.vtk .vtu .mesh .msh).");
@@ -219,12 +297,30 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 1;
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    // A usage error: say what was wrong, then the usage of the (sub)command given.
+    std::fprintf(stderr, "hexpeel: error: %s\n\n%s", e.what(), app.help().c_str());
+    return 1;
   }
   try {
     if (*check) return cmd_check(in, sharp_angle, json_out);
     if (*mesh) {
+      params.search = planner == "search";
+      params.elimination.order.side_rule = side_rule == "cost" ? SideRule::cost : SideRule::heavier;
       params.sharp_angle_deg = sharp_angle;
+      params.pillow.mode = pillow == "all"    ? PillowMode::all
+                           : pillow == "none" ? PillowMode::none
+                                              : PillowMode::automatic;
+      params.untangle.untangle = !no_untangle;
+      params.untangle.optimize = !no_optimize;
+      OrderParams& order = params.elimination.order;
+      order.method = method == "original" ? Method::original : Method::kremer;
+      order.zero_volume = !no_zero_volume;
+      order.enclosed = !no_enclosed;
+      order.concave = !no_concave;
+      order.false_positive = !no_false_positive;
+      order.concave_waits_for_enclosed = !no_concave_waits;
+      params.reconstruction.fallback_to_extrusion = !strict_intrusion;
       return cmd_mesh(in, out, report, dump_stuck, params, quiet);
     }
     if (*quality) return cmd_quality(in, surface, json_out);

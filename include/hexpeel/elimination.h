@@ -29,6 +29,7 @@ struct StuckReport {
 struct EliminationStats {
   int32_t steps = 0;
   int32_t flat_steps = 0;          ///< flat chords eliminated (nothing else was feasible)
+  int32_t concave_steps = 0;       ///< steps to be reconstructed by intrusion (Kremer 5.3)
   int64_t predicted_hexes = 0;     ///< 1 + sum of |side|
   int32_t feasibility_tests = 0;
   double time_s = 0.0;
@@ -42,6 +43,9 @@ struct EliminationPlan {
   StuckReport stuck;               ///< when stuck
   EliminationStats stats;
 };
+
+/// Why no remaining chord of `state` can be eliminated: counts per reason, and a sentence.
+StuckReport diagnose_stuck(const EliminationState& state);
 
 /// Greedy elimination in the paper's order, applied to `state` (fresh from its constructor).
 /// Self-intersecting chords make the status `self_intersecting_chord` at once. Afterwards `state`

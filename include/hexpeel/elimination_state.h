@@ -61,7 +61,7 @@ struct ChordQuadRecord {
 struct PlanStep {
   int32_t chord = -1;                 ///< id in the input ChordSet
   int8_t side = 0;                    ///< 0 = left, 1 = right of the chord's walking direction
-  bool concave = false;               ///< reconstructed by intrusion (Kremer 5.3) — not yet used
+  bool concave = false;               ///< reconstructed by intrusion (Kremer 5.3)
   std::vector<int32_t> side_quads;    ///< quads on side s (sorted ids); |side| hexes
   std::vector<ChordQuadRecord> chord_quads;  ///< in chord walking order
   double priority = 0.0;              ///< the weight that chose this step
@@ -81,6 +81,8 @@ class EliminationState {
   bool chord_alive(int32_t c) const { return chord_len_[c] > 0; }
   int32_t chord_length(int32_t c) const { return chord_len_[c]; }
   int32_t num_chords() const { return static_cast<int32_t>(chords_->chords.size()); }
+  /// The input chord set (chord_of tells which chords pass through a quad).
+  const ChordSet& chord_set() const { return *chords_; }
   int32_t steps_applied() const { return static_cast<int32_t>(marks_.size()); }
 
   /// The current passages of chord c (input steps whose quad is alive), in walking order.
@@ -110,7 +112,8 @@ class EliminationState {
   /// Quads on side s of chord c (sorted ids), by a search that never enters the chord.
   void side_region(int32_t c, int side, std::vector<int32_t>& out) const;
 
-  /// Number of quads on side s of chord c.
+  /// Number of quads on side s of chord c. The first call after a change computes all chords'
+  /// sizes at once by spanning-tree flux (O(quads + chord lengths)); later calls are O(1).
   int32_t side_size(int32_t c, int side) const;
 
   /// Collapses chord c, recording the step for side s (which must be usable). O(|c| + |side|).
@@ -126,6 +129,7 @@ class EliminationState {
   int32_t find(int32_t v) const;
   bool side_usable(const std::vector<ChordStep>& steps, int side) const;
   Infeasible collapse_test(const std::vector<ChordStep>& steps) const;
+  void compute_side_sizes() const;
   void mark_chord_quads(const std::vector<ChordStep>& steps) const;
   bool is_marked(int32_t q) const { return cmark_[q] == cepoch_; }
   void set_opp(int32_t he, int32_t value);
@@ -157,8 +161,14 @@ class EliminationState {
   mutable std::vector<int32_t> cmark_;   ///< chord-quad marks (== cepoch_)
   mutable int32_t cepoch_ = 0;
   mutable std::vector<int32_t> local_parent_;  ///< collapse_test's trial merges (-1 = root)
+  mutable std::vector<int32_t> vstamp_, rstamp_;  ///< collapse_test: vertex in VC / in R marks
+  mutable std::vector<int32_t> qstamp_;           ///< collapse_test: quad seen marks
+  mutable int32_t vepoch_ = 0, repoch_ = 0, qepoch_ = 0;
   mutable std::vector<int32_t> chord_hits_;    ///< collapse_test: crossings per other chord
   mutable std::vector<ChordStep> scratch_steps_;
+  mutable bool sizes_valid_ = false;                     ///< side_sizes_ match the surface
+  mutable std::vector<std::array<int32_t, 2>> side_sizes_;  ///< per chord, [left, right]
+  mutable std::vector<int32_t> tree_parent_, tree_size_;  ///< dual spanning tree (scratch)
 };
 
 }  // namespace hexpeel

@@ -33,7 +33,15 @@ Status read_obj(std::string_view data, const std::string& name, CellSoup& out) {
           return cur.error("expected a vertex index (a non-zero integer), found " + quoted(t));
         }
         // 1-based absolute, or relative to the vertices read so far; 0-based here.
-        face.push_back(i > 0 ? i - 1 : static_cast<int64_t>(out.points.size()) + i);
+        const auto read_so_far = static_cast<int64_t>(out.points.size());
+        if (i < -read_so_far) {  // (not -i: i may be INT64_MIN)
+          return Status::error(StatusCode::index_out_of_range,
+                               located(name, at_line(line),
+                                       "relative vertex index " + std::to_string(i) +
+                                           " points before the first vertex (" +
+                                           std::to_string(read_so_far) + " read so far)"));
+        }
+        face.push_back(i > 0 ? i - 1 : read_so_far + i);
       }
       if (face.empty()) return cur.error("face has no vertices");
       out.add_cell(CellKind::polygon, face.data(), face.size(), at_line(line));

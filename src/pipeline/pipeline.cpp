@@ -4,6 +4,7 @@
 // input vertex i, at the same position), then the interior vertices in construction order.
 #include "hexpeel/pipeline.h"
 
+#include <algorithm>
 #include <chrono>
 
 namespace hexpeel {
@@ -37,6 +38,7 @@ HexMesh renumber(const HexMesh& mesh, const HexComplex& complex, int32_t surface
 
 MeshResult run_mesh(const PolygonSoup& soup, const MeshParams& params, const Context& ctx) {
   MeshResult r;
+  r.method = params.elimination.order;
   auto t = std::chrono::steady_clock::now();
   r.diagnosis = diagnose_surface(soup, params.sharp_angle_deg, ctx, params.validation);
   r.timings.check_s = seconds_since(t);
@@ -48,7 +50,15 @@ MeshResult run_mesh(const PolygonSoup& soup, const MeshParams& params, const Con
 
   t = std::chrono::steady_clock::now();
   EliminationState state(surface, r.diagnosis.chords, r.diagnosis.edges);
-  r.plan = run_elimination(state, params.elimination, ctx);
+  if (params.search) {
+    PlannerParams pp = params.planner;
+    pp.order = params.elimination.order;
+    PlannerResult pr = run_planner(state, pp, ctx);
+    r.plan = std::move(pr.plan);
+    r.planner = pr.stats;
+  } else {
+    r.plan = run_elimination(state, params.elimination, ctx);
+  }
   r.timings.elimination_s = seconds_since(t);
   if (!r.plan.status.ok()) {
     r.status = r.plan.status;
@@ -66,6 +76,17 @@ MeshResult run_mesh(const PolygonSoup& soup, const MeshParams& params, const Con
   }
 
   t = std::chrono::steady_clock::now();
+  PillowResult pillowed = run_pillow(surface, rec.complex, params.pillow, ctx);
+  r.pillow = pillowed.stats;
+  r.forced = std::move(pillowed.forced);
+  r.timings.pillow_s = seconds_since(t);
+  if (!pillowed.status.ok()) {
+    r.status = pillowed.status;
+    return r;
+  }
+  rec.complex = std::move(pillowed.complex);
+
+  t = std::chrono::steady_clock::now();
   PlacementResult placed = run_placement(surface, rec.complex, params.placement, ctx);
   r.placement = placed.stats;
   r.timings.placement_s = seconds_since(t);
@@ -74,6 +95,20 @@ MeshResult run_mesh(const PolygonSoup& soup, const MeshParams& params, const Con
     return r;
   }
   r.mesh = renumber(placed.mesh, rec.complex, surface.num_points());
+
+  if (params.untangle.untangle || params.untangle.optimize) {
+    t = std::chrono::steady_clock::now();
+    std::vector<uint8_t> fixed(r.mesh.points.size(), 0);
+    std::fill(fixed.begin(), fixed.begin() + surface.num_points(), uint8_t{1});
+    UntangleResult u = run_untangle(r.mesh, fixed, params.untangle, ctx);
+    r.untangle = u.stats;
+    r.timings.untangle_s = seconds_since(t);
+    if (!u.status.ok()) {
+      r.status = u.status;
+      return r;
+    }
+    r.mesh = std::move(u.mesh);
+  }
 
   t = std::chrono::steady_clock::now();
   r.quality = run_quality(r.mesh, params.quality, &surface, ctx);
@@ -86,6 +121,10 @@ MeshResult run_mesh(const PolygonSoup& soup, const MeshParams& params, const Con
   return r;
 }
 
+namespace {
+bool params_used_search(const MeshResult& r) { return r.planner.nodes > 0 || r.planner.plans_tried > 0; }
+}  // namespace
+
 nlohmann::json to_json(const MeshResult& r) {
   nlohmann::json j = r.status.ok() ? to_json(r.quality) : nlohmann::json::object();
   j["status"] = std::string(to_string(r.status.code));
@@ -97,9 +136,22 @@ nlohmann::json to_json(const MeshResult& r) {
                  {"mean_length", cs.mean_length},
                  {"max_length", cs.max_length},
                  {"self_intersecting", cs.self_intersecting}};
+  const OrderParams& order = r.method;
+  j["method"] = {{"name", std::string(to_string(order.method))},
+                 {"rules",
+                  order.method == Method::kremer
+                      ? nlohmann::json{{"zero_volume", order.zero_volume},
+                                       {"zero_volume_tolerance_deg", order.zero_volume_tolerance_deg},
+                                       {"enclosed", order.enclosed},
+                                       {"concave", order.concave},
+                                       {"both_convex_min", order.both_convex_min},
+                                       {"false_positive", order.false_positive},
+                                       {"concave_waits_for_enclosed", order.concave_waits_for_enclosed}}
+                      : nlohmann::json::object()}};
   j["steps"] = r.plan.stats.steps;
   j["plan"] = {{"steps", r.plan.stats.steps},
                {"flat_steps", r.plan.stats.flat_steps},
+               {"concave_steps", r.plan.stats.concave_steps},
                {"predicted_hexes", r.plan.stats.predicted_hexes},
                {"feasibility_tests", r.plan.stats.feasibility_tests}};
   if (r.plan.status.code == StatusCode::stuck) {
@@ -111,18 +163,76 @@ nlohmann::json to_json(const MeshResult& r) {
                   {"chords_left", r.plan.stuck.chords_left},
                   {"reasons", reasons}};
   }
+  if (params_used_search(r)) {
+    j["planner"] = {{"plans_tried", r.planner.plans_tried},
+                    {"nodes", r.planner.nodes},
+                    {"backtracks", r.planner.backtracks},
+                    {"states_remembered", r.planner.states_remembered},
+                    {"stuck_events", r.planner.stuck_events},
+                    {"best_cost", r.planner.best_cost},
+                    {"strategy", r.planner.strategy},
+                    {"budget_exhausted", r.planner.budget_exhausted},
+                    {"time_s", r.planner.time_s}};
+  }
   j["reconstruction"] = {{"hexes", r.reconstruction.hexes},
                          {"slit_edges", r.reconstruction.slit_edges},
-                         {"steps_verified", r.reconstruction.steps_verified}};
+                         {"steps_verified", r.reconstruction.steps_verified},
+                         {"intrusions", r.reconstruction.intrusions},
+                         {"hexes_intruded", r.reconstruction.hexes_intruded},
+                         {"invalid_intrusion_steps", r.reconstruction.invalid_intrusion_steps}};
   j["placement"] = {{"method", "harmonic"},
                     {"interior_vertices", r.placement.interior_vertices},
                     {"coincident_pairs_separated", r.placement.coincident_pairs - r.placement.coincident_after},
                     {"coincident_pairs_left", r.placement.coincident_after},
                     {"nonpositive_hexes", r.placement.nonpositive_hexes}};
+  {
+    const PillowStats& p = r.pillow;
+    nlohmann::json forced = nlohmann::json::array();
+    for (size_t i = 0; i < r.forced.size() && i < 100; ++i)
+      forced.push_back({{"hex", r.forced[i].hex},
+                        {"corner", r.forced[i].corner},
+                        {"kind", std::string(to_string(r.forced[i].kind))},
+                        {"scaled_jacobian", r.forced[i].scaled_jacobian}});
+    j["pillow"] = {{"forced", p.forced},
+                   {"flat_doublets", p.flat_doublets},
+                   {"concave_corners", p.concave_corners},
+                   {"fixed_corners", p.fixed_corners},
+                   {"collinear", p.collinear},
+                   {"forced_list", forced},
+                   {"forced_after", p.forced_after},
+                   {"excluded_vertices", p.excluded_vertices},
+                   {"shrink_set", p.shrink_set},
+                   {"new_hexes", p.new_hexes},
+                   {"new_vertices", p.new_vertices},
+                   {"whole_boundary", p.whole_boundary}};
+    const UntangleStats& u = r.untangle;
+    auto phase = [](const UntanglePhaseStats& s) {
+      return nlohmann::json{{"rounds", s.rounds},
+                            {"iterations", s.iterations},
+                            {"evaluations", s.evaluations},
+                            {"time_s", s.time_s},
+                            {"min_sj_before", s.min_sj_before},
+                            {"min_sj_after", s.min_sj_after},
+                            {"nonpositive_before", s.nonpositive_before},
+                            {"nonpositive_after", s.nonpositive_after}};
+    };
+    j["untangle"] = {{"method", "lbfgs"},
+                     {"free_vertices", u.free_vertices},
+                     {"active_corners", u.active_corners},
+                     {"forced_corners", u.forced_corners},
+                     {"forced_nonpositive", u.forced_nonpositive},
+                     {"final_eps", u.final_eps},
+                     {"untangle", phase(u.untangle)},
+                     {"optimize", phase(u.optimize)},
+                     {"optimize_reverted", u.optimize_reverted},
+                     {"time_s", u.time_s}};
+  }
   j["timings_s"] = {{"check", r.timings.check_s},
                     {"elimination", r.timings.elimination_s},
                     {"reconstruction", r.timings.reconstruction_s},
+                    {"pillow", r.timings.pillow_s},
                     {"placement", r.timings.placement_s},
+                    {"untangle", r.timings.untangle_s},
                     {"quality", r.timings.quality_s}};
   return j;
 }

@@ -29,6 +29,16 @@ std::string stuck_text(const StuckReport& r) {
 
 }  // namespace
 
+StuckReport diagnose_stuck(const EliminationState& state) {
+  StuckReport r;
+  r.quads_left = state.alive_quads();
+  r.chords_left = state.alive_chords();
+  for (int32_t c = 0; c < state.num_chords(); ++c)
+    if (state.chord_alive(c)) ++r.reasons[static_cast<size_t>(state.feasibility(c).why)];
+  r.text = stuck_text(r);
+  return r;
+}
+
 EliminationPlan run_elimination(EliminationState& state, const EliminationParams& params,
                                 const Context& ctx) {
   using clock = std::chrono::steady_clock;
@@ -79,20 +89,16 @@ EliminationPlan run_elimination(EliminationState& state, const EliminationParams
       step.priority = -move.key[1];
       plan.stats.predicted_hexes += (move.concave ? -1 : 1) * static_cast<int64_t>(step.side_quads.size());
       plan.stats.flat_steps += step.flat;
+      plan.stats.concave_steps += step.concave;
       plan.steps.push_back(std::move(step));
       chosen = true;
       break;
     }
     if (!chosen) {
-      StuckReport& r = plan.stuck;
-      r.quads_left = state.alive_quads();
-      r.chords_left = state.alive_chords();
-      for (int32_t c = 0; c < nchords; ++c)
-        if (state.chord_alive(c)) ++r.reasons[static_cast<size_t>(state.feasibility(c).why)];
-      r.text = stuck_text(r);
+      plan.stuck = diagnose_stuck(state);
       plan.status = Status::error(StatusCode::stuck,
                                   "elimination stuck after " + std::to_string(plan.steps.size()) +
-                                      " steps: " + r.text);
+                                      " steps: " + plan.stuck.text);
       break;
     }
     ctx.report("elimination", static_cast<double>(plan.steps.size()) / total_steps);

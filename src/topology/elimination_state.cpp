@@ -34,6 +34,14 @@ std::string_view to_string(Infeasible why) {
 }
 
 namespace {
+/// Advances an epoch counter for a stamp array, clearing the array when the counter wraps.
+int32_t next_epoch(int32_t& epoch, std::vector<int32_t>& stamps) {
+  if (++epoch == 0) {
+    std::fill(stamps.begin(), stamps.end(), 0);
+    epoch = 1;
+  }
+  return epoch;
+}
 inline int32_t he_of(int32_t q, int k) { return 4 * q + (k & 3); }
 inline uint64_t edge_key(int32_t a, int32_t b) {
   if (a > b) std::swap(a, b);
@@ -67,6 +75,9 @@ EliminationState::EliminationState(const QuadSurface& surface, const ChordSet& c
   stamp_.assign(nq, 0);
   cmark_.assign(nq, 0);
   local_parent_.assign(nv, -1);
+  vstamp_.assign(nv, 0);
+  rstamp_.assign(nv, 0);
+  qstamp_.assign(nq, 0);
   chord_hits_.assign(chords.chords.size(), 0);
 }
 
@@ -143,9 +154,63 @@ void EliminationState::side_region(int32_t c, int side, std::vector<int32_t>& ou
 }
 
 int32_t EliminationState::side_size(int32_t c, int side) const {
-  std::vector<int32_t> region;
-  side_region(c, side, region);
-  return static_cast<int32_t>(region.size());
+  if (!sizes_valid_) compute_side_sizes();
+  return side_sizes_[c][side];
+}
+
+void EliminationState::compute_side_sizes() const {
+  // Spanning tree of the dual graph (alive quads, breadth first), subtree sizes; the quads on a
+  // side of chord c are then the net subtree flux through c's parallel edges on that side:
+  // tree edges entering the side add their child's subtree, edges leaving it subtract the
+  // chord quad's subtree; a non-positive total means the root is on that side (add all quads).
+  const int32_t nq = surface_->num_quads();
+  tree_parent_.assign(nq, -1);
+  tree_size_.assign(nq, 0);
+  std::vector<int32_t> order;
+  order.reserve(alive_quads_);
+  int32_t root = -1;
+  for (int32_t q = 0; q < nq && root < 0; ++q)
+    if (quad_alive_[q]) root = q;
+  const int32_t ep = next_epoch(epoch_, stamp_);
+  if (root >= 0) {
+    order.push_back(root);
+    stamp_[root] = ep;
+  }
+  for (size_t i = 0; i < order.size(); ++i)
+    for (int k = 0; k < 4; ++k) {
+      int32_t n = opp_[he_of(order[i], k)] >> 2;
+      if (stamp_[n] == ep) continue;
+      stamp_[n] = ep;
+      tree_parent_[n] = order[i];
+      order.push_back(n);
+    }
+  for (size_t i = order.size(); i-- > 0;) {
+    tree_size_[order[i]] += 1;
+    if (tree_parent_[order[i]] >= 0) tree_size_[tree_parent_[order[i]]] += tree_size_[order[i]];
+  }
+  const int32_t n_alive = static_cast<int32_t>(order.size());
+  side_sizes_.assign(chords_->chords.size(), {0, 0});
+  for (size_t c = 0; c < chords_->chords.size(); ++c) {
+    if (chord_len_[c] == 0 || chords_->chords[c].self_intersecting) continue;
+    auto in_chord = [&](int32_t q) {
+      return chords_->chord_of[2 * q] == static_cast<int32_t>(c) ||
+             chords_->chord_of[2 * q + 1] == static_cast<int32_t>(c);
+    };
+    for (int side = 0; side < 2; ++side) {
+      int64_t flux = 0;
+      bool any = false;
+      for (const ChordStep& st : chords_->chords[c].steps) {
+        if (!quad_alive_[st.quad]) continue;
+        int32_t h = opp_[he_of(st.quad, st.edge + (side == 0 ? 3 : 1))] >> 2;
+        if (in_chord(h)) continue;
+        any = true;
+        if (tree_parent_[h] == st.quad) flux += tree_size_[h];
+        else if (tree_parent_[st.quad] == h) flux -= tree_size_[st.quad];
+      }
+      side_sizes_[c][side] = any ? static_cast<int32_t>(flux > 0 ? flux : flux + n_alive) : 0;
+    }
+  }
+  sizes_valid_ = true;
 }
 
 bool EliminationState::side_usable(const std::vector<ChordStep>& steps, int side) const {
@@ -210,24 +275,20 @@ Infeasible EliminationState::collapse_test(const std::vector<ChordStep>& steps) 
     for (int32_t v : touched) local_parent_[v] = -1;
   };
 
-  // VC: current vertices of the chord quads; rotate around each to find the quads touching them.
+  // VC: current vertices of the chord quads (one (quad, corner) kept per vertex); rotate around
+  // each to find the quads touching them. Stamps replace sorting for the deduplication.
+  const int32_t vep = next_epoch(vepoch_, vstamp_);
   std::vector<int32_t> vc;
-  std::vector<std::pair<int32_t, int>> vc_corner;  // a (quad, corner) at each VC vertex
+  std::vector<std::pair<int32_t, int>> vc_corner;
   for (const ChordStep& s : steps)
-    for (int k = 0; k < 4; ++k) vc_corner.push_back({s.quad, k});
-  for (auto& qc : vc_corner) vc.push_back(find(surface_->quads[qc.first][qc.second]));
-  {
-    // keep one (quad, corner) per distinct vertex
-    std::vector<std::pair<int32_t, std::pair<int32_t, int>>> tmp;
-    for (size_t i = 0; i < vc.size(); ++i) tmp.push_back({vc[i], vc_corner[i]});
-    std::sort(tmp.begin(), tmp.end());
-    tmp.erase(std::unique(tmp.begin(), tmp.end(),
-                          [](auto& x, auto& y) { return x.first == y.first; }),
-              tmp.end());
-    vc.clear();
-    vc_corner.clear();
-    for (auto& t : tmp) vc.push_back(t.first), vc_corner.push_back(t.second);
-  }
+    for (int k = 0; k < 4; ++k) {
+      int32_t v = find(surface_->quads[s.quad][k]);
+      if (vstamp_[v] == vep) continue;
+      vstamp_[v] = vep;
+      vc.push_back(v);
+      vc_corner.push_back({s.quad, k});
+    }
+  auto in_vc = [&](int32_t v) { return vstamp_[v] == vep; };
   auto rotate = [&](int32_t q, int k, auto&& visit) {
     // visits every (quad, corner) around the vertex at corner k of q
     int32_t q0 = q;
@@ -241,17 +302,16 @@ Infeasible EliminationState::collapse_test(const std::vector<ChordStep>& steps) 
       HEXPEEL_ASSERT(++guard < 1 << 24);
     } while (q != q0 || k != k0);
   };
-  std::vector<int32_t> faces_a;  // non-chord quads touching VC
+  const int32_t qep = next_epoch(qepoch_, qstamp_);
+  std::vector<int32_t> faces_a;       // non-chord quads touching VC
   std::vector<int32_t> vc_faces_all;  // chord + non-chord quads touching VC (for the Euler count)
   for (auto& qc : vc_corner)
     rotate(qc.first, qc.second, [&](int32_t q, int) {
+      if (qstamp_[q] == qep) return;
+      qstamp_[q] = qep;
       vc_faces_all.push_back(q);
       if (!is_marked(q)) faces_a.push_back(q);
     });
-  std::sort(faces_a.begin(), faces_a.end());
-  faces_a.erase(std::unique(faces_a.begin(), faces_a.end()), faces_a.end());
-  std::sort(vc_faces_all.begin(), vc_faces_all.end());
-  vc_faces_all.erase(std::unique(vc_faces_all.begin(), vc_faces_all.end()), vc_faces_all.end());
 
   // New corners of the touching quads.
   std::vector<Quad> newf(faces_a.size());
@@ -265,9 +325,9 @@ Infeasible EliminationState::collapse_test(const std::vector<ChordStep>& steps) 
   // R: merged vertices (images of VC).
   std::vector<int32_t> rset;
   for (int32_t v : vc) rset.push_back(lfind(v));
-  std::sort(rset.begin(), rset.end());
-  rset.erase(std::unique(rset.begin(), rset.end()), rset.end());
-  auto in_r = [&](int32_t v) { return std::binary_search(rset.begin(), rset.end(), v); };
+  const int32_t rep = next_epoch(repoch_, rstamp_);
+  for (int32_t v : rset) rstamp_[v] = rep;
+  auto in_r = [&](int32_t v) { return rstamp_[v] == rep; };
 
   // Edges touching R: (key, face index) pairs; every key must appear exactly twice.
   std::vector<std::pair<uint64_t, int32_t>> ekeys;
@@ -327,11 +387,17 @@ Infeasible EliminationState::collapse_test(const std::vector<ChordStep>& steps) 
   // and the quads must form one fan (connected through edges at that vertex).
   std::vector<int32_t> at;
   std::vector<std::pair<int32_t, int32_t>> links;
+  // (merged vertex, face index) pairs, grouped by vertex
+  std::vector<std::pair<int32_t, int32_t>> faces_at;
+  for (size_t i = 0; i < newf.size(); ++i)
+    for (int k = 0; k < 4; ++k)
+      if (in_r(newf[i][k])) faces_at.push_back({newf[i][k], static_cast<int32_t>(i)});
+  std::sort(faces_at.begin(), faces_at.end());
+  size_t fa = 0;
   for (int32_t r : rlive) {
     at.clear();
-    for (size_t i = 0; i < newf.size(); ++i)
-      if (std::find(newf[i].begin(), newf[i].end(), r) != newf[i].end())
-        at.push_back(static_cast<int32_t>(i));
+    while (fa < faces_at.size() && faces_at[fa].first < r) ++fa;
+    for (; fa < faces_at.size() && faces_at[fa].first == r; ++fa) at.push_back(faces_at[fa].second);
     for (size_t a = 0; a < at.size(); ++a)
       for (size_t b = a + 1; b < at.size(); ++b) {
         const Quad& ta = newf[at[a]];
@@ -377,8 +443,7 @@ Infeasible EliminationState::collapse_test(const std::vector<ChordStep>& steps) 
     const Quad& f = surface_->quads[q];
     for (int k = 0; k < 4; ++k) {
       int32_t a = find(f[k]), b = find(f[(k + 1) & 3]);
-      if (std::binary_search(vc.begin(), vc.end(), a) || std::binary_search(vc.begin(), vc.end(), b))
-        old_edges.push_back(edge_key(a, b));
+      if (in_vc(a) || in_vc(b)) old_edges.push_back(edge_key(a, b));
     }
   }
   std::sort(old_edges.begin(), old_edges.end());
@@ -459,6 +524,7 @@ PlanStep EliminationState::apply(int32_t c, int side) {
   }
 
   marks_.push_back(log_.size());
+  sizes_valid_ = false;
   // Merge the chord's parallel edges: follow each chain of chord quads (more than one when the
   // chord touches itself) from a non-chord half-edge to the next one and pair those two.
   for (const ChordStep& s : steps)
@@ -517,6 +583,7 @@ PlanStep EliminationState::apply(int32_t c, int side) {
 
 void EliminationState::undo() {
   HEXPEEL_ASSERT(!marks_.empty());
+  sizes_valid_ = false;
   size_t mark = marks_.back();
   marks_.pop_back();
   while (log_.size() > mark) {

@@ -1,21 +1,185 @@
-// Chord ranking and side choice (paper 3.4).
+// Chord ranking and side choice: Müller-Hannemann's weights (paper 3.4) and the rules of Kremer,
+// Bommes, Lim, Kobbelt (IMR 2013) sections 4.1, 4.2, 5.1, 5.2 and 5.4.
 //
 // Original method: priority grows with the larger side weight (sharp parallel edges per chord
 // length); flat chords (crossing no sharp edge) only when nothing else is feasible; ties by
 // shorter chord, then smaller id. Side: the heavier usable side; equal weights -> the side with
 // fewer quads (fewer hexes), then left.
+//
+// Kremer method: key[0] is a tier, the sum of postponements (smaller first):
+//   concave chord (5.1-5.2)                                   0   (key[1] = -concavity weight)
+//   convex chord                                              1   (key[1] = -sharp weight)
+//   + convex on both sides (5.2, weight >= both_convex_min)   2
+//   + zero-volume configuration (4.1)                         4
+//   + waits for an enclosed chord (4.2, 5.4)                  8
+//   + flat (crosses no sharp edge; never concave)            16
+// A chord is concave on side s when its concavity weight on s is positive and at least
+// concave_min, s is usable, the
+// side region is flat (5.4 false positives: no sharp edge between two of its quads) and encloses
+// no non-flat chord (5.4 "enclosed concave cycles"); a concave candidate failing only the last
+// test is rated as a convex chord that waits. 4.2 prefers a usable side that encloses no whole
+// chord; a chord enclosing one on every usable side waits.
+//
+// Zero volume (4.1): the paper measures dihedral angles outside the solid (3.4), i.e. 180 + bend
+// with our signed bends (>0 convex). Two successive crossed edges whose outside angles sum to
+// about 180 degrees (bend_i + bend_i+1 ~ -180, e.g. the two concave edges of a one-quad-wide
+// groove floor) make a layer with a zero-volume hex. Bends of merged edges add (3.4).
+//
+// quick() uses only the chord's own weights and crossed edges: it is optimistic about concavity
+// (tier 0 whenever a concavity weight is positive) and ignores the region rules, which can only
+// raise the tier, so it stays a lower bound of full(). Everything is deterministic: keys end
+// with the chord id, sides tie-break on region size, then left.
 #include "hexpeel/order.h"
 
 #include <algorithm>
+#include <cmath>
 
 namespace hexpeel {
+
+std::string_view to_string(Method method) {
+  switch (method) {
+    case Method::original: return "original";
+    case Method::kremer: return "kremer";
+  }
+  return "?";
+}
+
+namespace {
+
+constexpr double kTierConvex = 1, kTierBothConvex = 2, kTierZeroVolume = 4, kTierWaits = 8,
+                 kTierFlat = 16;
+
+/// 4.1: two successive crossed edges of chord c whose outside dihedral angles sum to ~180 deg.
+bool has_zero_volume(const EliminationState& state, int32_t c, double tolerance_deg) {
+  // Walk the input passages, skipping eliminated quads (no allocation: called for every chord).
+  const std::vector<ChordStep>& steps = state.chord_set().chords[c].steps;
+  double first = 0.0, prev = 0.0;
+  bool any = false;
+  for (const ChordStep& s : steps) {
+    if (!state.quad_alive(s.quad)) continue;
+    const double b = state.edge_weight(4 * s.quad + s.edge).bend;
+    if (!any) first = b, any = true;
+    else if (std::abs(prev + b + 180.0) <= tolerance_deg) return true;
+    prev = b;
+  }
+  return any && state.chord_length(c) > 1 && std::abs(prev + first + 180.0) <= tolerance_deg;
+}
+
+/// What a side region holds: whole chords (any / non-flat) and whether it is flat inside.
+struct RegionFacts {
+  int32_t size = 0;
+  bool encloses_chord = false;     ///< some alive chord other than c lies entirely inside
+  bool encloses_nonflat = false;   ///< ... and crosses a sharp edge
+  bool flat_inside = true;         ///< no sharp edge between two quads of the region
+};
+
+RegionFacts region_facts(const EliminationState& state, int32_t c, int side) {
+  std::vector<int32_t> region;
+  state.side_region(c, side, region);
+  RegionFacts f;
+  f.size = static_cast<int32_t>(region.size());
+  auto inside = [&](int32_t q) { return std::binary_search(region.begin(), region.end(), q); };
+  // Passages of each chord inside the region; a chord is enclosed when all its passages are.
+  const ChordSet& cs = state.chord_set();
+  std::vector<std::pair<int32_t, int32_t>> hits;  // (chord, count), sorted by chord
+  std::vector<int32_t> through;
+  through.reserve(2 * region.size());
+  for (int32_t q : region) {
+    through.push_back(cs.chord_of[2 * q]);
+    through.push_back(cs.chord_of[2 * q + 1]);
+    if (f.flat_inside)
+      for (int k = 0; k < 4; ++k) {
+        const int32_t he = 4 * q + k;
+        if (state.edge_weight(he).sharp > 0 && inside(state.opposite(he) >> 2)) f.flat_inside = false;
+      }
+  }
+  std::sort(through.begin(), through.end());
+  for (size_t i = 0; i < through.size();) {
+    size_t j = i;
+    while (j < through.size() && through[j] == through[i]) ++j;
+    const int32_t d = through[i];
+    if (d != c && state.chord_alive(d) && static_cast<int32_t>(j - i) == state.chord_length(d)) {
+      f.encloses_chord = true;
+      if (state.weights(d).crossing_sharp > 0) f.encloses_nonflat = true;
+    }
+    i = j;
+  }
+  return f;
+}
+
+/// The original side rule among `sides`: heavier sharp weight; ties -> fewer quads, then left.
+int heavier_side(const EliminationState& state, int32_t chord, const ChordWeights& w,
+                 std::array<bool, 2> sides, const std::array<int32_t, 2>& sizes) {
+  if (sides[0] && sides[1] && w.sharp[0] == w.sharp[1]) {
+    const int32_t s0 = sizes[0] >= 0 ? sizes[0] : state.side_size(chord, 0);
+    const int32_t s1 = sizes[1] >= 0 ? sizes[1] : state.side_size(chord, 1);
+    return s1 < s0 ? 1 : 0;
+  }
+  if (sides[0] && sides[1]) return w.sharp[0] > w.sharp[1] ? 0 : 1;
+  return sides[0] ? 0 : 1;
+}
+
+/// The side a convex move takes under SideRule::cost, and that side's size.
+std::pair<int, int32_t> cost_side(const EliminationState& state, int32_t chord, const ChordWeights& w,
+                                  std::array<bool, 2> sides, std::array<int32_t, 2> sizes,
+                                  const OrderParams& p) {
+  for (int s = 0; s < 2; ++s)
+    if (sides[s] && sizes[s] < 0) sizes[s] = state.side_size(chord, s);
+  if (!(sides[0] && sides[1])) {
+    int s = sides[0] ? 0 : 1;
+    return {s, sizes[s]};
+  }
+  const int small = sizes[1] < sizes[0] ? 1 : 0;
+  const int other = 1 - small;
+  const int s = w.sharp[other] - w.sharp[small] >= p.side_threshold ? other : small;
+  return {s, sizes[s]};
+}
+
+/// The key's weight entry for a convex move on `side`: minus its sharp weight, plus the size term
+/// of SideRule::cost (never below the quick key's -max weight, as quick() requires).
+double side_key(const EliminationState& state, const ChordWeights& w, int side, int32_t size,
+                const OrderParams& p) {
+  double k = -w.sharp[side];
+  if (p.side_rule == SideRule::cost)
+    k += p.size_weight * static_cast<double>(size) / std::max<int32_t>(1, state.alive_quads());
+  return k;
+}
+
+/// A lower bound of full()'s weight entry for a convex move whatever sides are usable: the
+/// smallest side_key over both sides (side sizes are O(1) once computed for the state).
+double quick_weight_key(const EliminationState& state, int32_t chord, const ChordWeights& w,
+                        const OrderParams& p) {
+  if (p.side_rule != SideRule::cost) return -std::max(w.sharp[0], w.sharp[1]);
+  return std::min(side_key(state, w, 0, state.side_size(chord, 0), p),
+                  side_key(state, w, 1, state.side_size(chord, 1), p));
+}
+
+}  // namespace
 
 Move OrderPolicy::quick(const EliminationState& state, int32_t chord) const {
   ChordWeights w = state.weights(chord);
   Move m;
   m.chord = chord;
   m.flat = w.crossing_sharp == 0;
-  m.key = {m.flat ? 1.0 : 0.0, -std::max(w.sharp[0], w.sharp[1]), static_cast<double>(w.length),
+  if (params_.method == Method::original) {
+    m.key = {m.flat ? 1.0 : 0.0, quick_weight_key(state, chord, w, params_),
+             static_cast<double>(w.length), static_cast<double>(chord)};
+    return m;
+  }
+  const double concavity = std::max(w.concave[0], w.concave[1]);
+  if (params_.concave && !m.flat && concavity > 0 && concavity >= params_.concave_min) {
+    m.key = {0.0, -concavity, static_cast<double>(w.length), static_cast<double>(chord)};
+    return m;
+  }
+  m.zero_volume = params_.zero_volume &&
+                  has_zero_volume(state, chord, params_.zero_volume_tolerance_deg);
+  double tier = kTierConvex;
+  if (params_.concave && w.convex[0] >= params_.both_convex_min &&
+      w.convex[1] >= params_.both_convex_min)
+    tier += kTierBothConvex;
+  if (m.zero_volume) tier += kTierZeroVolume;
+  if (m.flat) tier += kTierFlat;
+  m.key = {tier, quick_weight_key(state, chord, w, params_), static_cast<double>(w.length),
            static_cast<double>(chord)};
   return m;
 }
@@ -25,17 +189,77 @@ Move OrderPolicy::full(const EliminationState& state, int32_t chord, std::array<
   Move m;
   m.chord = chord;
   m.flat = w.crossing_sharp == 0;
-  double best = -1.0;
-  for (int s = 0; s < 2; ++s)
-    if (sides[s]) best = std::max(best, w.sharp[s]);
-  m.key = {m.flat ? 1.0 : 0.0, -best, static_cast<double>(w.length), static_cast<double>(chord)};
-  if (sides[0] && sides[1] && w.sharp[0] == w.sharp[1]) {
-    m.side = state.side_size(chord, 1) < state.side_size(chord, 0) ? 1 : 0;
-  } else if (sides[0] && sides[1]) {
-    m.side = w.sharp[0] > w.sharp[1] ? 0 : 1;
-  } else {
-    m.side = sides[0] ? 0 : 1;
+  if (params_.method == Method::original) {
+    double best = -1.0;
+    for (int s = 0; s < 2; ++s)
+      if (sides[s]) best = std::max(best, w.sharp[s]);
+    m.key = {m.flat ? 1.0 : 0.0, -best, static_cast<double>(w.length), static_cast<double>(chord)};
+    m.side = static_cast<int8_t>(heavier_side(state, chord, w, sides, {-1, -1}));
+    if (params_.side_rule == SideRule::cost) {
+      auto [side, size] = cost_side(state, chord, w, sides, {-1, -1}, params_);
+      m.side = static_cast<int8_t>(side);
+      m.key[1] = side_key(state, w, side, size, params_);
+    }
+    return m;
   }
+
+  std::array<RegionFacts, 2> facts{};
+  std::array<bool, 2> known{};
+  auto facts_of = [&](int s) -> const RegionFacts& {
+    if (!known[s]) facts[s] = region_facts(state, chord, s), known[s] = true;
+    return facts[s];
+  };
+  bool concave_waits = false;
+  if (params_.concave && !m.flat) {
+    // Concave sides, heavier concavity first (ties: left first).
+    int order[2] = {0, 1};
+    if (w.concave[1] > w.concave[0]) std::swap(order[0], order[1]);
+    for (int s : order) {
+      if (!sides[s] || w.concave[s] <= 0 || w.concave[s] < params_.concave_min) continue;
+      const RegionFacts& f = facts_of(s);
+      if (params_.false_positive && !f.flat_inside) continue;
+      if (params_.concave_waits_for_enclosed && f.encloses_nonflat) {
+        concave_waits = true;
+        continue;
+      }
+      m.concave = true;
+      m.side = static_cast<int8_t>(s);
+      m.key = {0.0, -w.concave[s], static_cast<double>(w.length), static_cast<double>(chord)};
+      return m;
+    }
+  }
+
+  // Convex: prefer usable sides that enclose no whole chord (4.2).
+  std::array<bool, 2> pick = sides;
+  if (params_.enclosed) {
+    std::array<bool, 2> open{};
+    for (int s = 0; s < 2; ++s) open[s] = sides[s] && !facts_of(s).encloses_chord;
+    if (open[0] || open[1]) pick = open;
+    else m.waits = true;
+  }
+  if (concave_waits) m.waits = true;
+  const std::array<int32_t, 2> sizes{known[0] ? facts[0].size : -1, known[1] ? facts[1].size : -1};
+  int side;
+  double weight_key;
+  if (params_.side_rule == SideRule::cost) {
+    auto [s, size] = cost_side(state, chord, w, pick, sizes, params_);
+    side = s;
+    weight_key = side_key(state, w, s, size, params_);
+  } else {
+    side = heavier_side(state, chord, w, pick, sizes);
+    weight_key = -w.sharp[side];
+  }
+  m.side = static_cast<int8_t>(side);
+  m.zero_volume = params_.zero_volume &&
+                  has_zero_volume(state, chord, params_.zero_volume_tolerance_deg);
+  double tier = kTierConvex;
+  if (params_.concave && w.convex[0] >= params_.both_convex_min &&
+      w.convex[1] >= params_.both_convex_min)
+    tier += kTierBothConvex;
+  if (m.zero_volume) tier += kTierZeroVolume;
+  if (m.waits) tier += kTierWaits;
+  if (m.flat) tier += kTierFlat;
+  m.key = {tier, weight_key, static_cast<double>(w.length), static_cast<double>(chord)};
   return m;
 }
 

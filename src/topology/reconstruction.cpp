@@ -1,21 +1,25 @@
-// Reconstruction by extrusion (paper section 3.3; DESIGN.md invariants 2, 3, 5).
+// Reconstruction by extrusion and intrusion (paper section 3.3, Kremer et al. 5.3; DESIGN.md
+// invariants 2-5).
 //
-// The complex starts as one hex on the final cube surface and grows by one extrusion per plan
-// step, in reverse order: every boundary face on the step's side s gets a hex on top, the new top
-// faces take over the quad ids, and each chord quad comes back as a side face on the edge it had
-// collapsed into. Patch corners get one copy per fan of patch quads around them; a chord that
-// touched itself left a "slit" edge inside the patch that receives two chord quads, and the patch
-// is cut open along it. Chord quads' corners come from the records (h, j) taken at elimination,
-// never from vertex ids (a merged vertex's representative says nothing about its side).
+// The complex starts as one hex on the final cube surface and changes by one step per plan
+// step, in reverse order. Convex steps extrude: every boundary face on the step's side s gets a
+// hex on top, the new top faces take over the quad ids, and each chord quad comes back as a side
+// face on the edge it had collapsed into. Patch corners get one copy per fan of patch quads around
+// them; a chord that touched itself left a "slit" edge inside the patch that receives two chord
+// quads, and the patch is cut open along it. Chord quads' corners come from the records (h, j)
+// taken at elimination, never from vertex ids (a merged vertex's representative says nothing about
+// its side). Concave steps intrude, the mirror image: the hexes under the side-s faces go.
 //
 // Assumes a plan with status ok made on `surface` (valid, outward). Guarantees: every hex is a
 // positive VTK hex combinatorially (bottom = outward quad), the boundary equals `surface` exactly
-// (checked), or the status is internal_error.
+// (checked), no vertex is unused; or the status is invalid_intrusion (an intrusion that cannot
+// remove exactly |side| hexes cleanly) or internal_error.
 #include "hexpeel/reconstruction.h"
 
 #include <algorithm>
 #include <chrono>
 #include <numeric>
+#include <tuple>
 
 namespace hexpeel {
 namespace {
@@ -235,6 +239,163 @@ Status extrude(Builder& b, const PlanStep& st, int32_t step_index, int32_t& slit
   return Status::success();
 }
 
+/// Reverse of one concave elimination step (Kremer et al. 5.3): intrude the side-s patch. The
+/// hexes under the side-s faces are removed; each side quad takes over the face opposite its
+/// old one (in corner order), and each chord quad comes back as the lateral face that hex had on
+/// the edge the chord quad collapsed into, now a face of the neighbouring hex. It is the mirror
+/// of extrude(). Checked before anything changes: |side| distinct hexes (paper 5.4), each
+/// opposite face shared with a hex that stays, each lateral face on a collapsed edge shared with
+/// a hex that stays, every other lateral face shared with another intruded hex. Failing any of
+/// these is invalid_intrusion and leaves `b` untouched.
+Status intrude(Builder& b, const PlanStep& st, int32_t step_index, int32_t& hexes_removed) {
+  const auto& region = st.side_quads;  // sorted
+  const size_t nr = region.size();
+  auto invalid = [&](const std::string& why) {
+    return Status::error(StatusCode::invalid_intrusion,
+                         "concave step " + std::to_string(step_index) + " (chord " +
+                             std::to_string(st.chord) + ", " + std::to_string(nr) +
+                             " side quads): " + why);
+  };
+  auto slot_of = [&](int32_t q) -> int32_t {
+    auto it = std::lower_bound(region.begin(), region.end(), q);
+    return it != region.end() && *it == q ? static_cast<int32_t>(it - region.begin()) : -1;
+  };
+  for (int32_t q : region)
+    if (!b.on_bnd[q]) return fail("side quad " + std::to_string(q) + " is not on the boundary");
+  // Every hex face, sorted by vertex set: face -> hexes.
+  struct FaceUse { FaceKey key; int32_t hex; };
+  std::vector<FaceUse> faces;
+  faces.reserve(6 * b.k.hexes.size());
+  for (size_t h = 0; h < b.k.hexes.size(); ++h)
+    for (const auto& lf : kHexFaces) {
+      const Hex& x = b.k.hexes[h];
+      faces.push_back({sorted_key({x[lf[0]], x[lf[1]], x[lf[2]], x[lf[3]]}), static_cast<int32_t>(h)});
+    }
+  std::sort(faces.begin(), faces.end(), [](const FaceUse& x, const FaceUse& y) {
+    return std::tie(x.key, x.hex) < std::tie(y.key, y.hex);
+  });
+  // The hexes using face `corners` other than `self`: -1 none, -2 more than one.
+  auto other_hex = [&](const Quad& corners, int32_t self) {
+    FaceKey key = sorted_key(corners);
+    auto lo = std::lower_bound(faces.begin(), faces.end(), key,
+                               [](const FaceUse& x, const FaceKey& k) { return x.key < k; });
+    int32_t other = -1;
+    for (auto it = lo; it != faces.end() && it->key == key; ++it)
+      if (it->hex != self) other = other < 0 ? it->hex : -2;
+    return other;
+  };
+  std::vector<int32_t> hex_of(nr);
+  for (size_t s = 0; s < nr; ++s) {
+    const Quad& top = b.bnd[region[s]];
+    FaceKey key = sorted_key(top);
+    auto lo = std::lower_bound(faces.begin(), faces.end(), key,
+                               [](const FaceUse& x, const FaceKey& k) { return x.key < k; });
+    if (lo == faces.end() || lo->key != key || (lo + 1 != faces.end() && (lo + 1)->key == key))
+      return fail("boundary face of quad " + std::to_string(region[s]) + " is not used by one hex");
+    hex_of[s] = lo->hex;
+  }
+  std::vector<int32_t> intruded = hex_of;
+  std::sort(intruded.begin(), intruded.end());
+  intruded.erase(std::unique(intruded.begin(), intruded.end()), intruded.end());
+  if (intruded.size() != nr)
+    return invalid("its faces lie on " + std::to_string(intruded.size()) +
+                   " distinct hexes, but an intrusion must remove exactly " + std::to_string(nr) +
+                   " (two side faces share a hex, paper 5.4)");
+  auto is_intruded = [&](int32_t h) { return h >= 0 && std::binary_search(intruded.begin(), intruded.end(), h); };
+  // Records by (h, j): the edges chord quads collapsed into.
+  std::vector<std::pair<int32_t, size_t>> rec;  // (4*slot + j, record index)
+  for (size_t r = 0; r < st.chord_quads.size(); ++r) {
+    const ChordQuadRecord& cr = st.chord_quads[r];
+    int32_t hs = slot_of(cr.h);
+    if (hs < 0) return fail("side-s neighbour of chord quad " + std::to_string(cr.quad) + " is not in the patch");
+    rec.push_back({4 * hs + cr.j, r});
+  }
+  std::sort(rec.begin(), rec.end());
+  // Opposite corners: bottom[4*s+k] lies across the hex edge leaving top corner k.
+  std::vector<int32_t> bottom(4 * nr, -1);
+  for (size_t s = 0; s < nr; ++s) {
+    const Quad& top = b.bnd[region[s]];
+    const Hex& x = b.k.hexes[hex_of[s]];
+    for (int k = 0; k < 4; ++k) {
+      int lk = static_cast<int>(std::find(x.begin(), x.end(), top[k]) - x.begin());
+      if (lk == 8) return fail("boundary face corner missing from its hex");
+      for (int nbr : kHexCornerFrames[lk])
+        if (std::find(top.begin(), top.end(), x[nbr]) == top.end()) bottom[4 * s + k] = x[nbr];
+    }
+    const int32_t self = hex_of[s];
+    const Quad bot{bottom[4 * s], bottom[4 * s + 1], bottom[4 * s + 2], bottom[4 * s + 3]};
+    const int32_t under = other_hex(bot, self);
+    if (under < 0 || is_intruded(under))
+      return invalid("the hex under side quad " + std::to_string(region[s]) +
+                     (under == -1 ? " has its opposite face on the boundary"
+                                  : " is stacked on another hex of the intrusion"));
+    for (int k = 0; k < 4; ++k) {
+      const Quad lat{top[k], top[(k + 1) & 3], bottom[4 * s + ((k + 1) & 3)], bottom[4 * s + k]};
+      const int32_t nb = other_hex(lat, self);
+      const bool collapsed = std::binary_search(
+          rec.begin(), rec.end(), std::pair<int32_t, size_t>{4 * static_cast<int32_t>(s) + k, 0},
+          [](const auto& x, const auto& y) { return x.first < y.first; });
+      if (nb < 0)
+        return invalid("the hex under side quad " + std::to_string(region[s]) +
+                       " has a side face on the boundary");
+      if (collapsed && is_intruded(nb))
+        return invalid("a chord quad of side quad " + std::to_string(region[s]) +
+                       " would come back between two intruded hexes");
+      if (!collapsed && !is_intruded(nb))
+        return invalid("the hex under side quad " + std::to_string(region[s]) +
+                       " would expose a face that is not a chord quad");
+    }
+  }
+  // Apply: chord quads first (they read the old top corners), then the side quads, then the hexes.
+  std::vector<std::pair<int32_t, Quad>> chord_faces;
+  for (const ChordQuadRecord& r : st.chord_quads) {
+    const int32_t hs = slot_of(r.h);
+    Quad t{};
+    t[r.es] = bottom[4 * hs + ((r.j + 1) & 3)];
+    t[(r.es + 1) & 3] = bottom[4 * hs + r.j];
+    t[(r.es + 3) & 3] = b.bnd[r.h][(r.j + 1) & 3];
+    t[(r.es + 2) & 3] = b.bnd[r.h][r.j];
+    if (b.on_bnd[r.quad]) return fail("chord quad " + std::to_string(r.quad) + " is already on the boundary");
+    chord_faces.push_back({r.quad, t});
+  }
+  for (size_t s = 0; s < nr; ++s)
+    b.bnd[region[s]] = {bottom[4 * s], bottom[4 * s + 1], bottom[4 * s + 2], bottom[4 * s + 3]};
+  for (auto& [g, t] : chord_faces) {
+    b.bnd[g] = t;
+    b.on_bnd[g] = 1;
+  }
+  std::vector<Hex> kept;
+  kept.reserve(b.k.hexes.size() - nr);
+  for (size_t h = 0; h < b.k.hexes.size(); ++h)
+    if (!is_intruded(static_cast<int32_t>(h))) kept.push_back(b.k.hexes[h]);
+  b.k.hexes = std::move(kept);
+  hexes_removed += static_cast<int32_t>(nr);
+  return Status::success();
+}
+
+/// Removes vertices no hex uses (left by intrusions) and renumbers the rest in order.
+int32_t remove_unused_vertices(Builder& b) {
+  std::vector<int32_t> to_new(b.k.num_vertices, -1);
+  for (const Hex& h : b.k.hexes)
+    for (int32_t v : h) to_new[v] = 0;
+  int32_t next = 0;
+  for (int32_t v = 0; v < b.k.num_vertices; ++v)
+    if (to_new[v] == 0) {
+      b.k.created_at[next] = b.k.created_at[v];
+      to_new[v] = next++;
+    }
+  const int32_t removed = b.k.num_vertices - next;
+  if (removed == 0) return 0;
+  b.k.created_at.resize(next);
+  b.k.num_vertices = next;
+  for (Hex& h : b.k.hexes)
+    for (int32_t& v : h) v = to_new[v];
+  for (size_t q = 0; q < b.bnd.size(); ++q)
+    if (b.on_bnd[q])
+      for (int32_t& v : b.bnd[q]) v = to_new[v];
+  return removed;
+}
+
 }  // namespace
 
 ReconstructionResult run_reconstruction(const QuadSurface& surface, const EliminationPlan& plan,
@@ -258,28 +419,63 @@ ReconstructionResult run_reconstruction(const QuadSurface& surface, const Elimin
     res.status = check_boundary(b, ids, surface.num_points(), [&](int32_t q) { return replay->corners(q); });
     ++res.stats.steps_verified;
   };
+  // With a replay, every step undoes it (intrusions are always checked against it).
+  const bool replay_ok = replay != nullptr &&
+                         replay->steps_applied() == static_cast<int32_t>(plan.steps.size());
   if (res.status.ok() && verify) verify_now();
   const int32_t n = static_cast<int32_t>(plan.steps.size());
   for (int32_t i = n - 1; i >= 0 && res.status.ok(); --i) {
     const PlanStep& st = plan.steps[i];
+    bool extruded = !st.concave;
     if (st.concave) {
-      res.status = Status::error(StatusCode::internal_error,
-                                 "concave steps (intrusion) are not implemented yet");
-      break;
+      // Intrude; an intrusion that passes its local checks but leaves a boundary other than the
+      // intermediate surface (checked whenever `replay` is given) is invalid too.
+      Builder before = b;
+      int32_t removed = 0;
+      res.status = intrude(b, st, i, removed);
+      if (res.status.ok() && replay_ok) {
+        replay->undo();
+        verify_now();
+        if (!res.status.ok()) {
+          res.status = Status::error(StatusCode::invalid_intrusion,
+                                     "concave step " + std::to_string(i) + " (chord " +
+                                         std::to_string(st.chord) +
+                                         "): the boundary after intrusion is not the surface "
+                                         "before the step: " + res.status.message);
+          b = std::move(before);
+        }
+      }
+      if (res.status.ok()) {
+        ++res.stats.intrusions;
+        res.stats.hexes_intruded += removed;
+      } else if (res.status.code == StatusCode::invalid_intrusion) {
+        res.stats.invalid_intrusion_steps.push_back(i);
+        if (!params.fallback_to_extrusion) break;
+        ctx.warn(res.status.message + "; extruded instead");
+        extruded = true;
+      } else {
+        res.status.message = "reconstruction of step " + std::to_string(i) + ": " + res.status.message;
+        break;
+      }
     }
-    res.status = extrude(b, st, i, res.stats.slit_edges);
-    if (!res.status.ok()) {
-      res.status.message = "reconstruction of step " + std::to_string(i) + ": " + res.status.message;
-      break;
-    }
-    if (verify) {
-      replay->undo();
-      verify_now();
-      if (!res.status.ok())
-        res.status.message = "after reconstructing step " + std::to_string(i) + ": " + res.status.message;
+    if (extruded) {
+      res.status = extrude(b, st, i, res.stats.slit_edges);
+      if (!res.status.ok()) {
+        res.status.message = "reconstruction of step " + std::to_string(i) + ": " + res.status.message;
+        break;
+      }
+      if (replay_ok) {
+        if (replay->steps_applied() == i + 1) replay->undo();
+        if (verify || st.concave) {
+          verify_now();
+          if (!res.status.ok())
+            res.status.message = "after reconstructing step " + std::to_string(i) + ": " + res.status.message;
+        }
+      }
     }
     ctx.report("reconstruction", static_cast<double>(n - i) / std::max(1, n));
   }
+  if (res.status.ok() && res.stats.intrusions > 0) res.stats.vertices_removed = remove_unused_vertices(b);
   if (res.status.ok()) {
     // Invariant 5: the final boundary is the input surface, by quad id and corner order.
     ids.resize(surface.num_quads());

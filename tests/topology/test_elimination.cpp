@@ -241,3 +241,32 @@ TEST(Elimination, CubeGridReachesTheCubeWithOnePlanStepPerChord) {
     EXPECT_EQ(st.alive_quads(), 6);
   }
 }
+
+TEST(Elimination, FluxSideSizesEqualSearchedRegions) {
+  int compared = 0;
+  for (const auto& g : small_surfaces()) {
+    Prepared p = prepare(g.surface);
+    EliminationState st(p.surface, p.chords, p.edges);
+    std::mt19937_64 rng(11);
+    std::vector<int32_t> region;
+    while (st.alive_chords() > 3) {
+      std::vector<std::pair<int32_t, int>> moves;
+      for (int32_t c = 0; c < st.num_chords(); ++c) {
+        if (!st.chord_alive(c)) continue;
+        auto f = st.feasibility(c);
+        for (int s = 0; s < 2; ++s) {
+          if (!f.sides[s]) continue;  // usable sides are edge-connected
+          st.side_region(c, s, region);
+          EXPECT_EQ(st.side_size(c, s), static_cast<int32_t>(region.size()))
+              << g.name << " step " << st.steps_applied() << " chord " << c << " side " << s;
+          ++compared;
+          if (f.ok()) moves.push_back({c, s});
+        }
+      }
+      if (moves.empty()) break;
+      auto [c, s] = moves[rng() % moves.size()];
+      st.apply(c, s);
+    }
+  }
+  EXPECT_GT(compared, 200);
+}

@@ -1,0 +1,93 @@
+// Forced configurations and pillowing (Mitchell & Tautges, "Pillowing doublets", 1995).
+//
+// With the boundary fixed, a hex corner whose 4 points are all boundary vertices has its Jacobian
+// decided by the surface: a flat doublet (two boundary faces of one hex at about 180 degrees) or
+// three boundary faces at a concave corner cannot be made positive by any placement. Pillowing a
+// shrink set S of hexes inserts one new hex on every face of S's boundary (S's hexes move onto
+// copies of their boundary vertices), which frees those corners and keeps the surface as it is.
+// Topology only (positions are read to detect forced corners); placement comes after.
+#pragma once
+
+#include "hexpeel/context.h"
+#include "hexpeel/quad_surface.h"
+#include "hexpeel/reconstruction.h"
+#include "hexpeel/status.h"
+
+#include <cstdint>
+#include <string_view>
+#include <vector>
+
+namespace hexpeel {
+
+enum class PillowMode {
+  none,       ///< never pillow
+  automatic,  ///< pillow a shrink set around the forced configurations only, when there are any
+  all,        ///< pillow the whole boundary
+};
+std::string_view to_string(PillowMode m);
+
+enum class ForcedKind {
+  flat_doublet,    ///< two boundary faces of the hex meet at the corner's edges (about 180 deg)
+  concave_corner,  ///< three boundary faces of the hex meet at the corner
+  fixed_corner,    ///< all 4 points on the boundary, fewer than two boundary faces of the hex
+  collinear,       ///< the corner's 3 fixed points are collinear: its Jacobian is always 0
+};
+std::string_view to_string(ForcedKind k);
+
+/// A hex corner no placement of interior vertices can make positive enough.
+struct ForcedConfiguration {
+  int32_t hex = -1;
+  int32_t corner = -1;      ///< local corner 0..7
+  ForcedKind kind = ForcedKind::fixed_corner;
+  double scaled_jacobian = 0.0;  ///< of the corner tetrahedron (fixed by the surface)
+};
+
+struct PillowParams {
+  PillowMode mode = PillowMode::automatic;
+  /// A forced corner whose scaled Jacobian (det of unit edge vectors) is <= this counts as a
+  /// forced configuration (dimensionless, in [-1, 1)). Below 0 the hex is inverted whatever the
+  /// placement; 0.2 (two boundary faces within ~12 deg of flat) also pillows corners that would
+  /// cap the mesh's minimum at a useless value (csphere_n12: 0.07 without, 0.6 with).
+  double forced_sj = 0.2;
+  /// Rings of face neighbours added to the forced hexes to make the local shrink set (0..10):
+  /// a larger set spreads the pillow's distortion over more hexes.
+  int grow = 2;
+  /// In auto mode, pillow the whole boundary instead when the local shrink set holds at least
+  /// this fraction of the hexes that touch the boundary (in [0, 1]; 1 = always local). Measured:
+  /// on cubed spheres and pillowed grids the whole layer then gives the higher minimum
+  /// (csphere_n12 0.77 vs 0.51), while sparse forced corners are better served locally.
+  double whole_fraction = 0.25;
+};
+
+struct PillowStats {
+  int32_t forced = 0;               ///< forced configurations found before pillowing
+  int32_t flat_doublets = 0, concave_corners = 0, fixed_corners = 0, collinear = 0;
+  int32_t forced_after = 0;         ///< forced configurations left after pillowing
+  int32_t excluded_vertices = 0;    ///< boundary vertices with no strictly inward direction
+  int32_t shrink_set = 0;           ///< hexes in the pillowed shrink set (0 = no pillow)
+  int32_t new_hexes = 0, new_vertices = 0;
+  bool whole_boundary = false;      ///< local pillowing could not be used; the whole set was
+  double time_s = 0.0;
+};
+
+struct PillowResult {
+  Status status;
+  HexComplex complex;                        ///< the input complex, pillowed or not
+  std::vector<ForcedConfiguration> forced;   ///< found before pillowing, by hex then corner
+  PillowStats stats;
+};
+
+/// Forced corners of `complex` (boundary vertices at `surface`'s positions): corners whose 4
+/// points are boundary vertices with scaled Jacobian <= forced_sj, and corners whose 3 boundary
+/// points are collinear. Sorted by hex, then corner.
+std::vector<ForcedConfiguration> find_forced_configurations(const QuadSurface& surface,
+                                                            const HexComplex& complex,
+                                                            double forced_sj = 0.2);
+
+/// Detects forced configurations and pillows as `params.mode` says. The result's boundary is the
+/// input surface, vertex for vertex (copies are new interior vertices, input_vertex = -1), and the
+/// complex stays a ball (checked; a pillow that breaks it is not applied).
+PillowResult run_pillow(const QuadSurface& surface, const HexComplex& complex,
+                        const PillowParams& params = {}, const Context& ctx = {});
+
+}  // namespace hexpeel

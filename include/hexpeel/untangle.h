@@ -1,0 +1,75 @@
+// Untangling and quality optimization of a hex mesh's free (interior) vertices.
+//
+// Phase 1 (untangle): the regularized Winslow-type energy of Garanzha, Kaporin, Kudryavtseva,
+// Protais, Ray and Sokolov ("Foldover-free maps in 50 lines of code", ACM TOG 2021; "Untangling and
+// optimization of spatial meshes", 2022) on the 8 corner tetrahedra of every hex, with their
+// epsilon continuation, minimized by L-BFGS. Phase 2 (optimize): a smoothed minimum of the corner
+// scaled Jacobians, minimized by L-BFGS whose line search rejects any step that makes a corner
+// non-positive, so no hex positive after phase 1 goes <= 0. Fixed vertices never move (bit for bit).
+// Same output for any thread count (fixed partitions, per-vertex sums in a fixed order).
+#pragma once
+
+#include "hexpeel/context.h"
+#include "hexpeel/hex_mesh.h"
+#include "hexpeel/status.h"
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace hexpeel {
+
+struct UntangleParams {
+  bool untangle = true;   ///< run phase 1 (Winslow energy with epsilon continuation)
+  bool optimize = true;   ///< run phase 2 (smoothed-min scaled Jacobian)
+  /// Weight of the volume term (det^2 + 1) / chi against the shape term tr(J^T J) / chi^(2/3)
+  /// (dimensionless, >= 0). det is measured against a cube of the mean hex volume.
+  double lambda = 1.0;
+  int max_outer = 60;             ///< epsilon continuation rounds in phase 1 (1..10000)
+  int max_inner = 400;            ///< L-BFGS iterations per round, both phases (1..100000)
+  double inner_gtol = 1e-5;       ///< L-BFGS gradient tolerance, relative to |x| (> 0)
+  double energy_rtol = 1e-5;      ///< phase 1 stops once all corners are positive and E changes by less
+  int lbfgs_memory = 8;           ///< L-BFGS history length (1..100)
+  /// Phase 2 minimizes sum exp(beta * (s_min - s)) over the corner scaled Jacobians s: larger beta
+  /// focuses harder on the worst corners (dimensionless, 1..200).
+  double beta = 30.0;
+  /// Phase 2 adds this times the phase 1 energy (eps ~ 0), which keeps edges from collapsing
+  /// (the scaled Jacobian alone does not see size). Dimensionless, >= 0.
+  double regularization = 0.1;
+  int max_quality_rounds = 4;     ///< phase 2 restarts (re-centred on the new minimum), 0..1000
+  int max_quality_inner = 150;    ///< L-BFGS iterations per phase 2 restart (1..100000)
+  /// A corner whose 3 fixed points are collinear within this sine counts as forced (dimensionless).
+  double collinear_tol = 1e-9;
+};
+
+struct UntanglePhaseStats {
+  int32_t rounds = 0;        ///< outer rounds (epsilon updates / phase 2 restarts)
+  int32_t iterations = 0;    ///< L-BFGS iterations, summed over rounds
+  int32_t evaluations = 0;   ///< energy + gradient evaluations
+  double time_s = 0.0;
+  double min_sj_before = 0.0, min_sj_after = 0.0;  ///< min Verdict hex SJ over all hexes
+  int32_t nonpositive_before = 0, nonpositive_after = 0;  ///< hexes with SJ <= 0
+};
+
+struct UntangleStats {
+  int32_t free_vertices = 0;
+  int32_t active_corners = 0;   ///< corner tetrahedra in the energy (some point free)
+  int32_t forced_corners = 0;   ///< left out: all 4 points fixed, or the fixed ones collinear
+  int32_t forced_nonpositive = 0;  ///< forced corners with det <= 0: no placement fixes them
+  UntanglePhaseStats untangle, optimize;
+  bool optimize_reverted = false;  ///< phase 2 made the minimum worse and was undone
+  double final_eps = 0.0;
+  double time_s = 0.0;
+};
+
+struct UntangleResult {
+  Status status;     ///< ok, also when hexes stay inverted (see stats.untangle.nonpositive_after)
+  HexMesh mesh;      ///< same hexes, free vertices moved
+  UntangleStats stats;
+};
+
+/// `fixed[v]` != 0 pins vertex v (one entry per point). Hexes must be non-empty-positioned (finite).
+UntangleResult run_untangle(const HexMesh& mesh, const std::vector<uint8_t>& fixed,
+                            const UntangleParams& params = {}, const Context& ctx = {});
+
+}  // namespace hexpeel

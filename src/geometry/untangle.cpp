@@ -1,0 +1,412 @@
+// Untangling and scaled-Jacobian optimization of the free vertices of a hex mesh.
+//
+// Method: Garanzha, Kaporin, Kudryavtseva, Protais, Ray, Sokolov, "Foldover-free maps in 50 lines
+// of code" (ACM TOG 2021, sections 3-4) and "Untangling and optimization of spatial meshes" (2022):
+// every hex corner (corner c with its three frame neighbours, kHexCornerFrames) is a tetrahedron
+// with Jacobian J = [e0 e1 e2] / h (e_k = p_{n_k} - p_c, h = a reference edge length, so a unit
+// cube of edge h has J = I). Phase 1 minimizes
+//     sum  tr(J^T J) / chi(det J, eps)^(2/3) + lambda (det^2 + 1) / chi(det J, eps),
+//     chi(D, eps) = (D + sqrt(eps^2 + D^2)) / 2,
+// with the papers' epsilon update after each L-BFGS run (eps follows the worst corner down to 0).
+// Corners whose 4 points are all fixed, or whose fixed points are collinear, cannot change their
+// sign: they are left out of the energy and out of the eps schedule (DESIGN.md "Geometry"),
+// otherwise eps would never reach 0. Phase 2 minimizes sum exp(beta (s_min - s)) over the corner
+// scaled Jacobians s = det / (|e0||e1||e2|) (a smoothed minimum); any trial point with a corner
+// s <= 0 has energy +inf, so the line search never accepts an inverting step.
+//
+// Input: any hex mesh with finite points; `fixed` marks pinned vertices. Output: the same mesh
+// with free vertices moved; fixed points are copied, never recomputed. Determinism: per-corner
+// terms are written to their own slots, energies summed over fixed blocks in block order, and
+// per-vertex gradients gathered in a fixed incidence order, so any thread count gives the same
+// bytes.
+#include "hexpeel/untangle.h"
+#include "hexpeel/quality.h"
+
+#include <Eigen/Geometry>
+#include <LBFGS.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+namespace hexpeel {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+constexpr int32_t kBlock = 2048;  // corners per reduction block (fixed: keeps sums deterministic)
+
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+/// chi(D, eps) in a form that does not cancel for D << 0 (the papers' regularized determinant).
+inline double chi(double d, double eps) {
+  const double r = std::sqrt(eps * eps + d * d);
+  return d > 0 ? 0.5 * (d + r) : 0.5 * eps * eps / (r - d);
+}
+inline double chi_deriv(double d, double eps) {
+  return 0.5 + 0.5 * d / std::sqrt(eps * eps + d * d);
+}
+
+/// The optimization problem on flat arrays.
+struct Problem {
+  std::vector<Vec3> base;                        ///< all points, scaled: (p - centre) / h
+  std::vector<int32_t> free_index;               ///< point -> unknown index, -1 if fixed
+  std::vector<int32_t> free_point;               ///< unknown index -> point
+  std::vector<std::array<int32_t, 4>> corners;   ///< active corners: (c, n0, n1, n2) point ids
+  std::vector<int32_t> inc_start;                ///< CSR over unknowns: slots 4*corner+k using it
+  std::vector<int32_t> inc_slot;
+  // work arrays (sized once, reused by every evaluation)
+  std::vector<Vec3> pos;                         ///< current positions of all points
+  std::vector<double> corner_f;                  ///< per-corner energy
+  std::vector<double> corner_det;                ///< per-corner det (phase 1) or s (phase 2)
+  std::vector<Vec3> corner_g;                    ///< 4 gradients per corner (slot 4*corner+k)
+  std::vector<double> block_sum;                 ///< per-block energy sums
+  int evaluations = 0;                           ///< energy + gradient evaluations so far
+
+  int32_t num_corners() const { return static_cast<int32_t>(corners.size()); }
+  int32_t num_blocks() const { return (num_corners() + kBlock - 1) / kBlock; }
+
+  void set_positions(const Eigen::VectorXd& x) {
+    pos = base;
+    for (size_t i = 0; i < free_point.size(); ++i) pos[free_point[i]] = x.segment<3>(3 * i);
+  }
+
+  /// Evaluates sum of kernel(corner) (energy, det, 4 gradients) and gathers the gradient.
+  template <typename Kernel>
+  double evaluate(const Eigen::VectorXd& x, Eigen::VectorXd& grad, const Kernel& kernel) {
+    ++evaluations;
+    set_positions(x);
+    const int32_t nb = num_blocks();
+    tbb::parallel_for(tbb::blocked_range<int32_t>(0, nb), [&](const tbb::blocked_range<int32_t>& r) {
+      for (int32_t b = r.begin(); b != r.end(); ++b) {
+        double s = 0.0;
+        const int32_t end = std::min(num_corners(), (b + 1) * kBlock);
+        for (int32_t c = b * kBlock; c < end; ++c) {
+          const auto& k = corners[c];
+          const Vec3 e0 = pos[k[1]] - pos[k[0]], e1 = pos[k[2]] - pos[k[0]],
+                     e2 = pos[k[3]] - pos[k[0]];
+          Vec3 g0, g1, g2;
+          double det;
+          const double f = kernel(e0, e1, e2, g0, g1, g2, det);
+          corner_f[c] = f;
+          corner_det[c] = det;
+          corner_g[4 * c + 0] = -(g0 + g1 + g2);
+          corner_g[4 * c + 1] = g0;
+          corner_g[4 * c + 2] = g1;
+          corner_g[4 * c + 3] = g2;
+          s += f;
+        }
+        block_sum[b] = s;
+      }
+    });
+    double total = 0.0;
+    for (int32_t b = 0; b < nb; ++b) total += block_sum[b];
+    const int32_t nu = static_cast<int32_t>(free_point.size());
+    tbb::parallel_for(tbb::blocked_range<int32_t>(0, nu, 1024), [&](const tbb::blocked_range<int32_t>& r) {
+      for (int32_t u = r.begin(); u != r.end(); ++u) {
+        Vec3 g = Vec3::Zero();
+        for (int32_t i = inc_start[u]; i < inc_start[u + 1]; ++i) g += corner_g[inc_slot[i]];
+        grad.segment<3>(3 * u) = g;
+      }
+    });
+    return total;
+  }
+
+  double min_corner_value() const {
+    double m = std::numeric_limits<double>::infinity();
+    for (double d : corner_det) m = std::min(m, d);
+    return m;
+  }
+};
+
+/// Phase 1 kernel: the regularized Winslow + volume energy of one corner tetrahedron.
+struct WinslowKernel {
+  double eps, lambda;
+  double operator()(const Vec3& e0, const Vec3& e1, const Vec3& e2, Vec3& g0, Vec3& g1, Vec3& g2,
+                    double& det) const {
+    const Vec3 d0 = e1.cross(e2), d1 = e2.cross(e0), d2 = e0.cross(e1);  // d det / d e_k
+    det = e0.dot(d0);
+    const double c1 = chi(det, eps), c2 = std::cbrt(c1 * c1), c3 = chi_deriv(det, eps);
+    const double tr = e0.squaredNorm() + e1.squaredNorm() + e2.squaredNorm();
+    const double fw = tr / c2, fv = (det * det + 1.0) / c1;
+    const double kd = -(2.0 / 3.0) * fw * c3 / c1 + lambda * (2.0 * det - fv * c3) / c1;
+    g0 = (2.0 / c2) * e0 + kd * d0;
+    g1 = (2.0 / c2) * e1 + kd * d1;
+    g2 = (2.0 / c2) * e2 + kd * d2;
+    return fw + lambda * fv;
+  }
+};
+
+/// Phase 2 kernel: exp(beta (s_ref - s)) of the corner scaled Jacobian s, +inf below the floor,
+/// plus mu times the phase 1 energy (eps ~ 0). s is scale invariant, so without the second term
+/// an edge can shrink to nothing (a pillow hex collapsing onto the boundary) at no cost; the
+/// volume part (det^2 + 1) / det of the Winslow energy keeps every corner's size.
+struct QualityKernel {
+  double beta, s_ref, floor;  ///< a trial point with s <= floor is rejected (energy +inf)
+  double mu;                  ///< weight of the Winslow regularizer
+  WinslowKernel winslow;
+  double operator()(const Vec3& e0, const Vec3& e1, const Vec3& e2, Vec3& g0, Vec3& g1, Vec3& g2,
+                    double& s) const {
+    const Vec3 d0 = e1.cross(e2), d1 = e2.cross(e0), d2 = e0.cross(e1);
+    const double det = e0.dot(d0);
+    const double a2 = e0.squaredNorm(), b2 = e1.squaredNorm(), c2 = e2.squaredNorm();
+    const double l = std::sqrt(a2 * b2 * c2);
+    if (!(l > 1e-300)) {
+      s = -1.0;
+      g0 = g1 = g2 = Vec3::Zero();
+      return std::numeric_limits<double>::infinity();
+    }
+    s = det / l;
+    if (s <= floor) {
+      g0 = g1 = g2 = Vec3::Zero();
+      return std::numeric_limits<double>::infinity();
+    }
+    const double f = std::exp(beta * (s_ref - s));
+    const double k = -beta * f;  // df/ds
+    Vec3 w0, w1, w2;
+    double wdet;
+    const double fw = winslow(e0, e1, e2, w0, w1, w2, wdet);
+    g0 = k * (d0 / l - (s / a2) * e0) + mu * w0;
+    g1 = k * (d1 / l - (s / b2) * e1) + mu * w1;
+    g2 = k * (d2 / l - (s / c2) * e2) + mu * w2;
+    return f + mu * fw;
+  }
+};
+
+/// Runs L-BFGS on `kernel` from x; x ends at the lowest finite energy seen. Returns iterations.
+template <typename Kernel>
+int minimize(Problem& prob, const Kernel& kernel, Eigen::VectorXd& x, const UntangleParams& p,
+             int max_iterations) {
+  if (x.size() == 0) return 0;
+  LBFGSpp::LBFGSParam<double> lp;
+  lp.m = p.lbfgs_memory;
+  lp.epsilon = 1e-10;
+  lp.epsilon_rel = p.inner_gtol;
+  lp.max_iterations = max_iterations;
+  lp.max_linesearch = 40;
+  LBFGSpp::LBFGSSolver<double> solver(lp);
+  double best = std::numeric_limits<double>::infinity();
+  Eigen::VectorXd best_x = x;
+  auto fun = [&](const Eigen::VectorXd& y, Eigen::VectorXd& g) {
+    const double f = prob.evaluate(y, g, kernel);
+    if (std::isfinite(f) && f < best) {
+      best = f;
+      best_x = y;
+    }
+    return f;
+  };
+  int iters = 0;
+  double fx = 0.0;
+  try {
+    iters = solver.minimize(fun, x, fx);
+  } catch (const std::exception&) {
+    // Line search failures near the optimum or at the barrier: keep the best point seen (the
+    // iterations of an interrupted run are not known; evaluations are counted instead).
+    iters = 0;
+  }
+  if (std::isfinite(best)) x = best_x;
+  return iters;
+}
+
+struct HexQuality {
+  double min = 1.0;
+  int32_t nonpositive = 0;
+};
+
+HexQuality hex_quality(const HexMesh& mesh) {
+  HexQuality q;
+  std::vector<double> sj(mesh.hexes.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, mesh.hexes.size(), 512),
+                    [&](const tbb::blocked_range<size_t>& r) {
+                      for (size_t h = r.begin(); h != r.end(); ++h) {
+                        std::array<Vec3, 8> c;
+                        for (int k = 0; k < 8; ++k) c[k] = mesh.points[mesh.hexes[h][k]];
+                        sj[h] = scaled_jacobian(c);
+                      }
+                    });
+  for (double s : sj) {
+    q.min = std::min(q.min, s);
+    if (s <= 0.0) ++q.nonpositive;
+  }
+  return q;
+}
+
+}  // namespace
+
+UntangleResult run_untangle(const HexMesh& mesh, const std::vector<uint8_t>& fixed,
+                            const UntangleParams& params, const Context& ctx) {
+  const auto t_start = Clock::now();
+  UntangleResult res;
+  res.mesh = mesh;
+  const int32_t np = mesh.num_points();
+  if (static_cast<int32_t>(fixed.size()) != np) {
+    res.status = Status::error(StatusCode::internal_error, "untangle: fixed mask size != points");
+    return res;
+  }
+  const HexQuality q0 = hex_quality(mesh);
+  res.stats.untangle.min_sj_before = res.stats.untangle.min_sj_after = q0.min;
+  res.stats.untangle.nonpositive_before = res.stats.untangle.nonpositive_after = q0.nonpositive;
+
+  // Scale: centre on the bounding box, unit = mean length of fixed-fixed hex edges (the boundary
+  // quads' edges), or of all edges when nothing is fixed.
+  Problem prob;
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (const Vec3& p : mesh.points) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  const Vec3 centre = np > 0 ? Vec3(0.5 * (lo + hi)) : Vec3::Zero();
+  double len_fixed = 0.0, len_all = 0.0;
+  int64_t n_fixed = 0, n_all = 0;
+  for (const Hex& h : mesh.hexes)
+    for (const auto& e : kHexEdges) {
+      const double l = (mesh.points[h[e[0]]] - mesh.points[h[e[1]]]).norm();
+      len_all += l, ++n_all;
+      if (fixed[h[e[0]]] && fixed[h[e[1]]]) len_fixed += l, ++n_fixed;
+    }
+  double unit = n_fixed > 0 ? len_fixed / n_fixed : (n_all > 0 ? len_all / n_all : 1.0);
+  if (!(unit > 0.0) || !std::isfinite(unit)) unit = 1.0;
+  prob.base.resize(np);
+  for (int32_t v = 0; v < np; ++v) prob.base[v] = (mesh.points[v] - centre) / unit;
+
+  prob.free_index.assign(np, -1);
+  for (int32_t v = 0; v < np; ++v)
+    if (!fixed[v]) {
+      prob.free_index[v] = static_cast<int32_t>(prob.free_point.size());
+      prob.free_point.push_back(v);
+    }
+  const int32_t nu = static_cast<int32_t>(prob.free_point.size());
+  res.stats.free_vertices = nu;
+
+  // Active and forced corners.
+  for (const Hex& h : mesh.hexes)
+    for (int c = 0; c < 8; ++c) {
+      const std::array<int32_t, 4> k{h[c], h[kHexCornerFrames[c][0]], h[kHexCornerFrames[c][1]],
+                                     h[kHexCornerFrames[c][2]]};
+      int nfix = 0;
+      std::array<int32_t, 4> fx{};
+      for (int32_t v : k)
+        if (fixed[v]) fx[nfix++] = v;
+      bool forced = nfix == 4;
+      if (nfix == 3) {
+        const Vec3 a = prob.base[fx[1]] - prob.base[fx[0]], b = prob.base[fx[2]] - prob.base[fx[0]];
+        forced = a.cross(b).norm() <= params.collinear_tol * a.norm() * b.norm();
+      }
+      if (forced) {
+        ++res.stats.forced_corners;
+        const Vec3 e0 = prob.base[k[1]] - prob.base[k[0]], e1 = prob.base[k[2]] - prob.base[k[0]],
+                   e2 = prob.base[k[3]] - prob.base[k[0]];
+        if (e0.dot(e1.cross(e2)) <= 0.0) ++res.stats.forced_nonpositive;
+      } else {
+        prob.corners.push_back(k);
+      }
+    }
+  const int32_t nc = prob.num_corners();
+  res.stats.active_corners = nc;
+  // Incidence CSR: for each unknown, the corner slots that use it, in corner order.
+  prob.inc_start.assign(nu + 1, 0);
+  for (const auto& k : prob.corners)
+    for (int32_t v : k)
+      if (prob.free_index[v] >= 0) ++prob.inc_start[prob.free_index[v] + 1];
+  for (int32_t u = 0; u < nu; ++u) prob.inc_start[u + 1] += prob.inc_start[u];
+  prob.inc_slot.resize(prob.inc_start[nu]);
+  {
+    std::vector<int32_t> fill(prob.inc_start.begin(), prob.inc_start.end() - 1);
+    for (int32_t c = 0; c < nc; ++c)
+      for (int k = 0; k < 4; ++k) {
+        const int32_t u = prob.free_index[prob.corners[c][k]];
+        if (u >= 0) prob.inc_slot[fill[u]++] = 4 * c + k;
+      }
+  }
+  prob.corner_f.resize(nc);
+  prob.corner_det.resize(nc);
+  prob.corner_g.resize(4 * static_cast<size_t>(nc));
+  prob.block_sum.resize(prob.num_blocks());
+  if (nu == 0 || nc == 0) {
+    res.stats.time_s = seconds_since(t_start);
+    res.stats.optimize.min_sj_before = res.stats.optimize.min_sj_after = q0.min;
+    res.stats.optimize.nonpositive_before = res.stats.optimize.nonpositive_after = q0.nonpositive;
+    return res;
+  }
+
+  Eigen::VectorXd x(3 * nu), g(3 * nu);
+  for (int32_t u = 0; u < nu; ++u) x.segment<3>(3 * u) = prob.base[prob.free_point[u]];
+  auto write_back = [&](const Eigen::VectorXd& y) {
+    for (int32_t u = 0; u < nu; ++u)
+      res.mesh.points[prob.free_point[u]] = centre + unit * Vec3(y.segment<3>(3 * u));
+  };
+
+  // ---- Phase 1: untangle (Winslow energy, epsilon continuation) ----
+  if (params.untangle) {
+    const auto t1 = Clock::now();
+    const int ev0 = prob.evaluations;
+    WinslowKernel k{1.0, params.lambda};
+    prob.evaluate(x, g, k);
+    double detmin = prob.min_corner_value();
+    k.eps = detmin > 0 ? 1e-10 : 1.0;
+    for (int round = 0; round < params.max_outer; ++round) {
+      const double e_prev = prob.evaluate(x, g, k);
+      res.stats.untangle.iterations += minimize(prob, k, x, params, params.max_inner);
+      const double e = prob.evaluate(x, g, k);
+      detmin = prob.min_corner_value();
+      ++res.stats.untangle.rounds;
+      ctx.report("untangle", std::min(1.0, (round + 1.0) / params.max_outer));
+      if (detmin > 0 && std::abs(e_prev - e) <= params.energy_rtol * std::abs(e)) break;
+      const double sigma = std::max(1.0 - e / e_prev, 0.1);
+      const double mu = (1.0 - sigma) * chi(detmin, k.eps);
+      k.eps = detmin < mu ? 2.0 * std::sqrt(mu * (mu - detmin)) : 1e-10;
+    }
+    res.stats.final_eps = k.eps;
+    res.stats.untangle.evaluations = prob.evaluations - ev0;
+    write_back(x);
+    const HexQuality q1 = hex_quality(res.mesh);
+    res.stats.untangle.min_sj_after = q1.min;
+    res.stats.untangle.nonpositive_after = q1.nonpositive;
+    res.stats.untangle.time_s = seconds_since(t1);
+  }
+
+  // ---- Phase 2: raise the minimum corner scaled Jacobian, never crossing s <= 0 ----
+  res.stats.optimize.min_sj_before = res.stats.untangle.min_sj_after;
+  res.stats.optimize.nonpositive_before = res.stats.untangle.nonpositive_after;
+  res.stats.optimize.min_sj_after = res.stats.optimize.min_sj_before;
+  res.stats.optimize.nonpositive_after = res.stats.optimize.nonpositive_before;
+  if (params.optimize) {
+    const auto t2 = Clock::now();
+    const int ev0 = prob.evaluations;
+    const Eigen::VectorXd x_before = x;
+    QualityKernel k{params.beta, 0.0, 0.0, params.regularization, WinslowKernel{1e-10, params.lambda}};
+    k.floor = -std::numeric_limits<double>::infinity();
+    prob.evaluate(x, g, k);
+    double smin = prob.min_corner_value();
+    for (int round = 0; round < params.max_quality_rounds; ++round) {
+      k.s_ref = smin;
+      // Positive meshes stay positive; a mesh with inverted corners may not get worse.
+      k.floor = smin > 0 ? 0.0 : smin - 1e-12;
+      res.stats.optimize.iterations += minimize(prob, k, x, params, params.max_quality_inner);
+      prob.evaluate(x, g, k);
+      const double s = prob.min_corner_value();
+      ++res.stats.optimize.rounds;
+      ctx.report("optimize", (round + 1.0) / params.max_quality_rounds);
+      const bool done = s - smin < 1e-3;
+      smin = std::max(smin, s);
+      if (done) break;
+    }
+    res.stats.optimize.evaluations = prob.evaluations - ev0;
+    HexMesh before = res.mesh;
+    write_back(x);
+    const HexQuality q2 = hex_quality(res.mesh);
+    if (q2.min < res.stats.optimize.min_sj_before || q2.nonpositive > res.stats.optimize.nonpositive_before) {
+      res.mesh = std::move(before);
+      res.stats.optimize_reverted = true;
+    } else {
+      res.stats.optimize.min_sj_after = q2.min;
+      res.stats.optimize.nonpositive_after = q2.nonpositive;
+    }
+    res.stats.optimize.time_s = seconds_since(t2);
+  }
+  res.stats.time_s = seconds_since(t_start);
+  return res;
+}
+
+}  // namespace hexpeel

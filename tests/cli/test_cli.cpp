@@ -1,0 +1,493 @@
+// End-to-end tests of the hexpeel command line (apps/hexpeel/main.cpp): exit codes, messages on
+// stderr, files written or not written, JSON report keys, determinism. The binary comes from the
+// HEXPEEL_BIN environment variable (set by hexpeel_add_test); every fixture is generated here.
+#include "support/generators.h"
+#include "hexpeel/io.h"
+
+#include "topology/soups.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdlib>
+#include <fcntl.h>
+#include <filesystem>
+#include <fstream>
+#include <initializer_list>
+#include <sstream>
+#include <spawn.h>
+#include <string>
+#include <sys/wait.h>
+#include <unistd.h>
+#include <vector>
+
+extern char** environ;
+
+namespace {
+
+namespace fs = std::filesystem;
+namespace gen = hexpeel::testing;
+using namespace hexpeel;
+
+/// Outcome of one run of the binary.
+struct Outcome {
+  int exit_code = -1;   ///< exit status, -1 when the process did not exit normally
+  int signal = 0;       ///< the signal that ended it, 0 when it exited
+  std::string out, err;
+};
+
+std::string slurp(const fs::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+void spit(const fs::path& p, const std::string& bytes) {
+  std::ofstream f(p, std::ios::binary);
+  f << bytes;
+}
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const char* bin = std::getenv("HEXPEEL_BIN");
+    ASSERT_NE(bin, nullptr) << "HEXPEEL_BIN is not set";
+    bin_ = bin;
+    ASSERT_TRUE(fs::exists(bin_)) << bin_;
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::temp_directory_path() /
+           ("hexpeel_cli_" + std::to_string(::getpid()) + "_" + info->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+  }
+
+  /// Runs the binary with `args`, stdout and stderr captured, no shell involved.
+  Outcome run(std::initializer_list<std::string> args) {
+    std::vector<std::string> a{bin_};
+    a.insert(a.end(), args.begin(), args.end());
+    std::vector<char*> argv;
+    for (auto& s : a) argv.push_back(s.data());
+    argv.push_back(nullptr);
+    const fs::path out = dir_ / ".stdout", err = dir_ / ".stderr";
+    posix_spawn_file_actions_t fa;
+    posix_spawn_file_actions_init(&fa);
+    posix_spawn_file_actions_addopen(&fa, 1, out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_addopen(&fa, 2, err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    pid_t pid = 0;
+    Outcome r;
+    const int rc = posix_spawn(&pid, bin_.c_str(), &fa, nullptr, argv.data(), environ);
+    posix_spawn_file_actions_destroy(&fa);
+    EXPECT_EQ(rc, 0) << "cannot spawn " << bin_;
+    if (rc != 0) return r;
+    int status = 0;
+    while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    }
+    if (WIFEXITED(status)) r.exit_code = WEXITSTATUS(status);
+    if (WIFSIGNALED(status)) r.signal = WTERMSIG(status);
+    r.out = slurp(out);
+    r.err = slurp(err);
+    fs::remove(out);
+    fs::remove(err);
+    return r;
+  }
+
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  std::string write(const std::string& name, const std::string& bytes) {
+    spit(dir_ / name, bytes);
+    return path(name);
+  }
+  std::string write(const std::string& name, const QuadSurface& s) {
+    const Status st = write_surface(dir_ / name, s);
+    EXPECT_TRUE(st.ok()) << to_string(st);
+    return path(name);
+  }
+  /// Files in the test directory (names), sorted.
+  std::vector<std::string> listing() const {
+    std::vector<std::string> names;
+    for (const auto& e : fs::directory_iterator(dir_)) names.push_back(e.path().filename().string());
+    std::sort(names.begin(), names.end());
+    return names;
+  }
+
+  std::string bin_;
+  fs::path dir_;
+};
+
+/// A soup as OBJ text (1-based indices).
+std::string obj_text(const PolygonSoup& soup) {
+  std::ostringstream s;
+  s.precision(17);
+  for (const Vec3& p : soup.points) s << "v " << p.x() << ' ' << p.y() << ' ' << p.z() << '\n';
+  for (int32_t f = 0; f < soup.num_faces(); ++f) {
+    s << 'f';
+    for (int32_t i = soup.offsets[f]; i < soup.offsets[f + 1]; ++i) s << ' ' << soup.indices[i] + 1;
+    s << '\n';
+  }
+  return s.str();
+}
+
+/// The soup with `other` appended (its vertex ids shifted), optionally with vertices of `other`
+/// identified with vertices of `soup`: merge[i] = {other vertex, soup vertex}.
+PolygonSoup join(PolygonSoup soup, const PolygonSoup& other,
+                 const std::vector<std::pair<int32_t, int32_t>>& merge = {}) {
+  std::vector<int32_t> id(other.points.size(), -1);
+  for (auto [o, s] : merge) id[o] = s;
+  for (size_t i = 0; i < other.points.size(); ++i)
+    if (id[i] < 0) {
+      id[i] = static_cast<int32_t>(soup.points.size());
+      soup.points.push_back(other.points[i]);
+    }
+  for (int32_t f = 0; f < other.num_faces(); ++f) {
+    for (int32_t i = other.offsets[f]; i < other.offsets[f + 1]; ++i)
+      soup.indices.push_back(id[other.indices[i]]);
+    soup.offsets.push_back(static_cast<int32_t>(soup.indices.size()));
+  }
+  return soup;
+}
+
+PolygonSoup translated(PolygonSoup soup, const Vec3& d) {
+  for (Vec3& p : soup.points) p += d;
+  return soup;
+}
+
+/// The id of the vertex at (x,y,z), -1 if none.
+int32_t vertex_at(const PolygonSoup& soup, double x, double y, double z) {
+  for (size_t i = 0; i < soup.points.size(); ++i)
+    if (soup.points[i] == Vec3(x, y, z)) return static_cast<int32_t>(i);
+  return -1;
+}
+
+bool contains(const std::string& haystack, const std::string& needle) {
+  return haystack.find(needle) != std::string::npos;
+}
+
+#define EXPECT_NO_SIGNAL(r) EXPECT_EQ((r).signal, 0) << "killed by signal " << (r).signal << "\n" << (r).err
+
+// ---- check --------------------------------------------------------------------------------------
+
+TEST_F(Cli, CheckAcceptsValidSurface) {
+  const std::string in = write("cube3.obj", gen::cube(3, 3, 3, 1.0 / 3).surface);
+  Outcome r = run({"check", in, "--json", path("d.json")});
+  EXPECT_NO_SIGNAL(r);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(contains(r.out, "verdict")) << r.out;
+  EXPECT_TRUE(contains(r.out, "can be given to the mesher")) << r.out;
+  // the text names the counts, the genus, the chords and the sharp edges
+  EXPECT_TRUE(contains(r.out, "54")) << r.out;  // quads
+  EXPECT_TRUE(contains(r.out, "genus")) << r.out;
+  EXPECT_TRUE(contains(r.out, "chord")) << r.out;
+  EXPECT_TRUE(contains(r.out, "sharp")) << r.out;
+  EXPECT_TRUE(contains(r.out, "convex")) << r.out;
+  EXPECT_TRUE(contains(r.out, "concave")) << r.out;
+  ASSERT_TRUE(fs::exists(path("d.json")));
+  const auto j = nlohmann::json::parse(slurp(path("d.json")));
+  EXPECT_TRUE(j.at("status").at("ok").get<bool>());
+  EXPECT_EQ(j.at("chords").at("count").get<int>(), 9);
+}
+
+TEST_F(Cli, CheckAcceptsCubedSphereAndVoxelSolid) {
+  for (const auto& g : {gen::cubed_sphere_equiangular(4), gen::named_solid("L", 2)}) {
+    const std::string in = write(g.name + ".off", g.surface);
+    Outcome r = run({"check", in});
+    EXPECT_NO_SIGNAL(r);
+    EXPECT_EQ(r.exit_code, 0) << g.name << "\n" << r.out << r.err;
+  }
+}
+
+/// One bad input: file name, contents, and words the message must contain (any of each group).
+struct Bad {
+  std::string name;
+  std::string bytes;
+  std::vector<std::string> words;  ///< each must appear in stderr (case-sensitive)
+};
+
+std::vector<Bad> bad_inputs() {
+  using test::cube_soup;
+  std::vector<Bad> v;
+  const PolygonSoup cube = cube_soup();
+  // non-quad face: the first quad split into two triangles
+  {
+    PolygonSoup s;
+    s.points = cube.points;
+    const int32_t* q = &cube.indices[0];
+    s.add_face({q[0], q[1], q[2]});
+    s.add_face({q[0], q[2], q[3]});
+    for (int32_t f = 1; f < cube.num_faces(); ++f)
+      s.add_face({cube.indices[4 * f], cube.indices[4 * f + 1], cube.indices[4 * f + 2],
+                  cube.indices[4 * f + 3]});
+    v.push_back({"nonquad.obj", obj_text(s), {"non_quad", "face"}});
+  }
+  // open boundary: two opposite faces of the cube removed (4 quads, an open tube)
+  {
+    PolygonSoup s;
+    s.points = cube.points;
+    for (int32_t f = 2; f < cube.num_faces(); ++f)
+      s.add_face({cube.indices[4 * f], cube.indices[4 * f + 1], cube.indices[4 * f + 2],
+                  cube.indices[4 * f + 3]});
+    v.push_back({"open.obj", obj_text(s), {"open_boundary", "edge"}});
+  }
+  // non-manifold edge: two cubes sharing one edge
+  {
+    const PolygonSoup other = translated(cube, Vec3(1, 1, 0));
+    const PolygonSoup s = join(cube, other,
+                               {{vertex_at(other, 1, 1, 0), vertex_at(cube, 1, 1, 0)},
+                                {vertex_at(other, 1, 1, 1), vertex_at(cube, 1, 1, 1)}});
+    v.push_back({"nm_edge.obj", obj_text(s), {"non_manifold_edge", "edge"}});
+  }
+  // non-manifold vertex: two cubes sharing one corner
+  {
+    const PolygonSoup other = translated(cube, Vec3(1, 1, 1));
+    const PolygonSoup s = join(cube, other, {{vertex_at(other, 1, 1, 1), vertex_at(cube, 1, 1, 1)}});
+    v.push_back({"nm_vertex.obj", obj_text(s), {"non_manifold_vertex", "vertex"}});
+  }
+  v.push_back({"inconsistent.obj", obj_text(test::with_face_reversed(cube, 2)),
+               {"inconsistent_orientation", "quad"}});
+  v.push_back({"two.obj", obj_text(join(cube, translated(cube, Vec3(3, 0, 0)))),
+               {"multiple_components", "component"}});
+  v.push_back({"torus.obj", obj_text(test::torus_soup(8, 4)), {"nonzero_genus", "genus 1"}});
+  v.push_back({"odd.obj", obj_text(test::prism_radial_soup()), {"odd_quad_count", "9"}});
+  // a valid closed genus-0 surface (8 quads) whose one chord crosses itself
+  v.push_back({"selfint.obj",
+               obj_text(test::radial_soup({{1, 1, 0}, {-1, 1, 0}, {-1, -1, 0}, {1, -1, 0}, {0, 0, 1}},
+                                          {{0, 3, 2, 1}, {0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}})),
+               {"self_intersecting_chord", "crosses itself"}});
+  // degenerate quad: a quad with a repeated corner
+  {
+    PolygonSoup s = cube;
+    s.add_face({0, 1, 1, 2});
+    v.push_back({"degenerate.obj", obj_text(s), {"degenerate", "quad"}});
+  }
+  // duplicate vertex: a second copy of a corner, used by one of its quads
+  {
+    PolygonSoup s = cube;
+    s.points.push_back(s.points[s.indices[0]]);
+    s.indices[0] = static_cast<int32_t>(s.points.size()) - 1;
+    v.push_back({"dupvert.obj", obj_text(s), {"duplicate_vertex", "vertex"}});
+  }
+  {
+    std::string t = obj_text(cube);
+    t.replace(t.find("v 0 0 0"), 7, "v nan 0 0");
+    v.push_back({"nan.obj", t, {"non_finite", "NaN"}});
+  }
+  {
+    std::string t = obj_text(cube);
+    t += "f 1 2 3 99\n";
+    v.push_back({"range.obj", t, {"index_out_of_range", "99"}});
+  }
+  {
+    std::string t = obj_text(cube);
+    t += "f 1 2 3 -99\n";  // relative index before the first vertex
+    v.push_back({"relrange.obj", t, {"index_out_of_range", "-99"}});
+  }
+  v.push_back({"empty.obj", "", {"empty"}});
+  v.push_back({"trunc.off", "OFF\n8 6 0\n0 0 0\n1 0 0\n1 1 0\n0 1", {"trunc.off"}});
+  {
+    std::string ply = "ply\nformat binary_little_endian 1.0\nelement vertex 8\nproperty float x\n"
+                      "property float y\nproperty float z\nelement face 6\n"
+                      "property list uchar int vertex_indices\nend_header\n";
+    ply += std::string(40, '\0');  // 40 of the 96 vertex bytes, no faces
+    v.push_back({"trunc.ply", ply, {"trunc.ply"}});
+  }
+  v.push_back({"surface.stl", "solid x\nendsolid x\n", {".stl"}});
+  return v;
+}
+
+TEST_F(Cli, CheckRejectsEveryBadInputClass) {
+  for (const Bad& b : bad_inputs()) {
+    SCOPED_TRACE(b.name);
+    const std::string in = write(b.name, b.bytes);
+    Outcome r = run({"check", in});
+    EXPECT_NO_SIGNAL(r);
+    EXPECT_NE(r.exit_code, 0) << r.out << r.err;
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    for (const std::string& w : b.words) EXPECT_TRUE(contains(r.err, w)) << "'" << w << "' not in:\n" << r.err;
+    EXPECT_FALSE(contains(r.out, "verdict: " + in + " can be given")) << r.out;
+  }
+}
+
+TEST_F(Cli, CheckFlipsInwardSurfaceWithWarning) {
+  PolygonSoup cube = test::cube_soup();
+  for (int32_t f = 0; f < cube.num_faces(); ++f) cube = test::with_face_reversed(cube, f);
+  const std::string in = write("inward.obj", obj_text(cube));
+  Outcome r = run({"check", in});
+  EXPECT_NO_SIGNAL(r);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(contains(r.err, "warning")) << r.err;
+  EXPECT_TRUE(contains(r.err, "inward")) << r.err;
+}
+
+TEST_F(Cli, CheckReportsUnreadableFiles) {
+  Outcome missing = run({"check", path("missing.obj")});
+  EXPECT_NO_SIGNAL(missing);
+  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_TRUE(contains(missing.err, "missing.obj")) << missing.err;
+  fs::create_directories(dir_ / "folder.obj");
+  Outcome folder = run({"check", path("folder.obj")});
+  EXPECT_NO_SIGNAL(folder);
+  EXPECT_EQ(folder.exit_code, 2);
+  EXPECT_TRUE(contains(folder.err, "folder.obj")) << folder.err;
+  EXPECT_TRUE(contains(folder.err, "directory")) << folder.err;
+}
+
+TEST_F(Cli, CheckNeverCrashesOnDamagedBytes) {
+  const std::string good = obj_text(test::grid_soup(2));
+  uint32_t x = 12345;
+  for (int round = 0; round < 20; ++round) {
+    std::string bytes = good;
+    for (int k = 0; k < 3; ++k) {
+      x = x * 1664525u + 1013904223u;
+      bytes[x % bytes.size()] = static_cast<char>(x >> 24);
+    }
+    const std::string in = write("damaged.obj", bytes);
+    Outcome r = run({"check", in});
+    EXPECT_NO_SIGNAL(r);
+    EXPECT_TRUE(r.exit_code == 0 || r.exit_code == 2) << "round " << round << " exit " << r.exit_code << "\n" << r.err;
+  }
+}
+
+// ---- mesh ---------------------------------------------------------------------------------------
+
+TEST_F(Cli, MeshWritesMeshAndReport) {
+  const std::string in = write("cube2.obj", gen::cube(2, 2, 2, 0.5).surface);
+  Outcome r = run({"mesh", in, "-o", path("out.vtk"), "--report", path("report.json"), "--quiet"});
+  EXPECT_NO_SIGNAL(r);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  ASSERT_TRUE(fs::exists(path("out.vtk")));
+  HexMesh mesh;
+  ASSERT_TRUE(read_hex_mesh(path("out.vtk"), mesh).ok());
+  const auto j = nlohmann::json::parse(slurp(path("report.json")));
+  EXPECT_EQ(j.at("hexes").get<int>(), mesh.num_hexes());
+  for (const char* k : {"min", "mean", "max", "count_nonpositive"}) EXPECT_TRUE(j.at("scaled_jacobian").contains(k)) << k;
+  for (const char* k : {"interior", "boundary"}) EXPECT_TRUE(j.at("singular_edges").contains(k)) << k;
+  EXPECT_EQ(j.at("euler_characteristic").get<int>(), 1);
+  EXPECT_TRUE(j.at("boundary_matches_surface").get<bool>());
+  EXPECT_TRUE(j.contains("chords"));
+  EXPECT_TRUE(j.contains("steps"));
+  EXPECT_EQ(j.at("status").get<std::string>(), "ok");
+  for (const char* k : {"read", "check", "elimination", "reconstruction", "placement", "write"})
+    EXPECT_TRUE(j.at("timings_s").contains(k)) << k;
+  EXPECT_EQ(listing(), (std::vector<std::string>{"cube2.obj", "out.vtk", "report.json"}));
+}
+
+TEST_F(Cli, MeshIsDeterministic) {
+  const std::string in = write("sphere.obj", gen::cubed_sphere_equiangular(3).surface);
+  for (const char* ext : {".vtk", ".vtu", ".mesh", ".msh"}) {
+    Outcome a = run({"mesh", in, "-o", path(std::string("a") + ext), "--quiet"});
+    Outcome b = run({"mesh", in, "-o", path(std::string("b") + ext), "--quiet"});
+    ASSERT_EQ(a.exit_code, 0) << a.err;
+    ASSERT_EQ(b.exit_code, 0) << b.err;
+    const std::string fa = slurp(path(std::string("a") + ext)), fb = slurp(path(std::string("b") + ext));
+    EXPECT_FALSE(fa.empty());
+    EXPECT_TRUE(fa == fb) << ext;
+  }
+}
+
+TEST_F(Cli, FailedMeshLeavesNoFileBehind) {
+  // bad input
+  const std::string bad = write("torus.obj", obj_text(test::torus_soup(8, 4)));
+  Outcome r = run({"mesh", bad, "-o", path("out.vtk")});
+  EXPECT_NO_SIGNAL(r);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_TRUE(contains(r.err, "genus")) << r.err;
+  EXPECT_EQ(listing(), std::vector<std::string>{"torus.obj"});
+  // unwritable output: the output's directory is a regular file
+  const std::string in = write("cube.obj", gen::cube(1, 1, 1).surface);
+  r = run({"mesh", in, "-o", path("torus.obj") + "/out.vtk", "--report", path("r.json")});
+  EXPECT_NO_SIGNAL(r);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_TRUE(contains(r.err, "out.vtk")) << r.err;
+  // the report of the failed run says why
+  EXPECT_EQ(nlohmann::json::parse(slurp(path("r.json"))).at("status").get<std::string>(), "io_error");
+  fs::remove(path("r.json"));
+  r = run({"mesh", in, "-o", path("nowhere") + "/out.vtk"});
+  EXPECT_NO_SIGNAL(r);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_EQ(listing(), (std::vector<std::string>{"cube.obj", "torus.obj"}));
+}
+
+TEST_F(Cli, MeshRejectsUnknownOutputExtensionFirst) {
+  // the input does not even exist: the output extension is reported before any reading
+  Outcome r = run({"mesh", path("missing.obj"), "-o", path("out.stl")});
+  EXPECT_NO_SIGNAL(r);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_TRUE(contains(r.err, "out.stl")) << r.err;
+  EXPECT_FALSE(contains(r.err, "missing.obj")) << r.err;
+  EXPECT_TRUE(listing().empty());
+}
+
+// ---- quality ------------------------------------------------------------------------------------
+
+TEST_F(Cli, QualityOfGoodMeshAndSurfaceMismatch) {
+  const gen::Generated g = gen::cube(2, 2, 2, 0.5);
+  const std::string surf = write("cube2.obj", g.surface);
+  ASSERT_TRUE(write_hex_mesh(path("grid.vtu"), g.known_mesh).ok());
+  Outcome r = run({"quality", path("grid.vtu"), "--surface", surf, "--json", path("q.json")});
+  EXPECT_NO_SIGNAL(r);
+  EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
+  const auto j = nlohmann::json::parse(slurp(path("q.json")));
+  EXPECT_EQ(j.at("hexes").get<int>(), 8);
+  EXPECT_NEAR(j.at("scaled_jacobian").at("min").get<double>(), 1.0, 1e-12);
+  EXPECT_NEAR(j.at("scaled_jacobian").at("mean").get<double>(), 1.0, 1e-12);
+  EXPECT_NEAR(j.at("scaled_jacobian").at("max").get<double>(), 1.0, 1e-12);
+  EXPECT_EQ(j.at("scaled_jacobian").at("count_nonpositive").get<int>(), 0);
+  EXPECT_EQ(j.at("singular_edges").at("interior").get<int>(), 0);
+  // boundary edges along the 12 cube edges (2 segments each) have one hex, not two
+  EXPECT_EQ(j.at("singular_edges").at("boundary").get<int>(), 24);
+  EXPECT_EQ(j.at("euler_characteristic").get<int>(), 1);
+  EXPECT_TRUE(j.at("boundary_matches_surface").get<bool>());
+
+  const std::string other = write("cube3.obj", gen::cube(3, 3, 3, 1.0 / 3).surface);
+  r = run({"quality", path("grid.vtu"), "--surface", other, "--json", path("q2.json")});
+  EXPECT_NO_SIGNAL(r);
+  EXPECT_EQ(r.exit_code, 2) << r.out;
+  EXPECT_TRUE(contains(r.err, "boundary differs from " + other)) << r.err;
+  const auto j2 = nlohmann::json::parse(slurp(path("q2.json")));
+  EXPECT_FALSE(j2.at("boundary_matches_surface").get<bool>());
+}
+
+TEST_F(Cli, QualityRejectsBadMeshFiles) {
+  Outcome r = run({"quality", path("missing.vtk")});
+  EXPECT_NO_SIGNAL(r);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(contains(r.err, "missing.vtk")) << r.err;
+  r = run({"quality", write("junk.msh", "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 8 1")});
+  EXPECT_NO_SIGNAL(r);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  r = run({"quality", write("mesh.xyz", "1 2 3\n")});
+  EXPECT_NO_SIGNAL(r);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_TRUE(contains(r.err, ".xyz")) << r.err;
+}
+
+// ---- usage --------------------------------------------------------------------------------------
+
+TEST_F(Cli, UsageErrorsExitOneWithUsage) {
+  for (const auto& args : std::vector<std::vector<std::string>>{
+           {}, {"check"}, {"mesh", "in.obj"}, {"quality"}, {"frobnicate"}, {"check", "a.obj", "--bogus"}}) {
+    std::string joined;
+    for (const auto& a : args) joined += a + " ";
+    SCOPED_TRACE(joined);
+    Outcome r;
+    switch (args.size()) {
+      case 0: r = run({}); break;
+      case 1: r = run({args[0]}); break;
+      case 2: r = run({args[0], args[1]}); break;
+      default: r = run({args[0], args[1], args[2]}); break;
+    }
+    EXPECT_NO_SIGNAL(r);
+    EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+    EXPECT_TRUE(contains(r.out + r.err, "Usage")) << r.out << r.err;
+  }
+  Outcome help = run({"--help"});
+  EXPECT_EQ(help.exit_code, 0);
+  EXPECT_TRUE(contains(help.out, "check")) << help.out;
+}
+
+}  // namespace
