@@ -25,8 +25,8 @@ struct UntangleParams {
   /// Weight of the volume term (det^2 + 1) / chi against the shape term tr(J^T J) / chi^(2/3)
   /// (dimensionless, >= 0). det is measured against a cube of the mean hex volume.
   double lambda = 1.0;
-  int max_outer = 60;             ///< epsilon continuation rounds in phase 1 (1..10000)
-  int max_inner = 400;            ///< L-BFGS iterations per round, both phases (1..100000)
+  int max_outer = 20;             ///< epsilon continuation rounds in phase 1 (1..10000)
+  int max_inner = 200;            ///< L-BFGS iterations per round, both phases (1..100000)
   double inner_gtol = 1e-5;       ///< L-BFGS gradient tolerance, relative to |x| (> 0)
   double energy_rtol = 1e-5;      ///< phase 1 stops once all corners are positive and E changes by less
   int lbfgs_memory = 8;           ///< L-BFGS history length (1..100)

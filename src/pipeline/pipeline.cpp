@@ -144,6 +144,7 @@ nlohmann::json to_json(const MeshResult& r) {
                                        {"zero_volume_tolerance_deg", order.zero_volume_tolerance_deg},
                                        {"enclosed", order.enclosed},
                                        {"concave", order.concave},
+                                       {"concave_min", order.concave_min},
                                        {"both_convex_min", order.both_convex_min},
                                        {"false_positive", order.false_positive},
                                        {"concave_waits_for_enclosed", order.concave_waits_for_enclosed}}

@@ -354,6 +354,7 @@ PlannerResult run_planner(EliminationState& state, const PlannerParams& params, 
     ps.flat = st.flat;
     plan.stats.predicted_hexes += (st.concave ? -1 : 1) * static_cast<int64_t>(ps.side_quads.size());
     plan.stats.flat_steps += st.flat;
+    plan.stats.concave_steps += st.concave;
     plan.steps.push_back(std::move(ps));
   }
   plan.stats.steps = static_cast<int32_t>(plan.steps.size());
