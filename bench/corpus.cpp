@@ -71,10 +71,10 @@ int main(int argc, char** argv) {
   std::string csv_text =
       "name,quads,chords,status,hexes,ref_hexes,min_sj,mean_sj,ref_min_sj,ref_mean_sj,"
       "sj_le_0,interior_singular_edges,read_s,check_s,elimination_s,reconstruction_s,"
-      "placement_s,quality_s,total_s,peak_rss_mb,message\n";
+      "pillow_s,placement_s,untangle_s,quality_s,total_s,peak_rss_mb,message\n";
   std::string md_text =
       "| surface | quads | chords | status | hexes (ref) | min SJ (ref) | mean SJ (ref) | SJ<=0 | "
-      "int. sing. edges | elim s | recon s | place s | total s | peak MB |\n"
+      "int. sing. edges | elim s | recon s | untangle s | total s | peak MB |\n"
       "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   int ok = 0;
   for (const fs::path& f : files) {
@@ -104,7 +104,8 @@ int main(int argc, char** argv) {
       return j.contains(a) && j[a].contains(b) && j[a][b].is_number() ? j[a][b].get<double>() : NAN;
     };
     double total = 0;
-    for (const char* s : {"read", "check", "elimination", "reconstruction", "placement", "quality"})
+    for (const char* s : {"read", "check", "elimination", "reconstruction", "pillow", "placement",
+                          "untangle", "quality"})
       total += std::isnan(num("timings_s", s)) ? 0.0 : num("timings_s", s);
     std::string hexes = meshed ? std::to_string(j.value("hexes", 0)) : "-";
     std::string minsj = meshed ? fmt(num("scaled_jacobian", "min")) : "-";
@@ -120,7 +121,9 @@ int main(int argc, char** argv) {
                 "," + fmt(num("timings_s", "check"), "%.4f") + "," +
                 fmt(num("timings_s", "elimination"), "%.4f") + "," +
                 fmt(num("timings_s", "reconstruction"), "%.4f") + "," +
+                fmt(num("timings_s", "pillow"), "%.4f") + "," +
                 fmt(num("timings_s", "placement"), "%.4f") + "," +
+                fmt(num("timings_s", "untangle"), "%.4f") + "," +
                 fmt(num("timings_s", "quality"), "%.4f") + "," + fmt(total, "%.4f") + "," +
                 fmt(r.peak_rss_kb / 1024.0, "%.1f") + "," + msg + "\n";
     auto withref = [](const std::string& v, const std::string& r) { return r.empty() ? v : v + " (" + r + ")"; };
@@ -130,7 +133,7 @@ int main(int argc, char** argv) {
                withref(meansj, rf.mean_sj) + " | " + nonpos + " | " + sing + " | " +
                fmt(num("timings_s", "elimination"), "%.3f") + " | " +
                fmt(num("timings_s", "reconstruction"), "%.3f") + " | " +
-               fmt(num("timings_s", "placement"), "%.3f") + " | " + fmt(total) + " | " +
+               fmt(num("timings_s", "untangle"), "%.3f") + " | " + fmt(total) + " | " +
                fmt(r.peak_rss_kb / 1024.0, "%.0f") + " |\n";
     std::printf("%-28s %-10s hexes %-8s min SJ %-7s mean SJ %-7s %.2f s %s\n", name.c_str(),
                 status.c_str(), hexes.c_str(), minsj.c_str(), meansj.c_str(), total,

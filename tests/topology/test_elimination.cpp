@@ -3,6 +3,7 @@
 #include "hexpeel/chords.h"
 #include "hexpeel/elimination.h"
 #include "support/generators.h"
+#include "support/prepared.h"
 
 #include <gtest/gtest.h>
 
@@ -16,19 +17,8 @@ namespace ht = hexpeel::testing;
 
 namespace {
 
-struct Prepared {
-  QuadSurface surface;
-  ChordSet chords;
-  EdgeGeometry edges;
-};
-
-Prepared prepare(const QuadSurface& s) {
-  Prepared p{s, {}, {}};
-  QuadAdjacency adj = build_adjacency(p.surface);
-  p.chords = find_chords(p.surface, adj);
-  p.edges = classify_edges(p.surface, adj, 60.0);
-  return p;
-}
+using ht::Prepared;
+using ht::prepare;
 
 /// Ground truth for one collapse: apply it globally on a copy of the current surface and test
 /// that the result is a polyhedral sphere: proper quads, every edge in two quads, one fan per

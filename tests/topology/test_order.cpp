@@ -9,6 +9,7 @@
 #include "hexpeel/quality.h"
 #include "hexpeel/reconstruction.h"
 #include "support/generators.h"
+#include "support/prepared.h"
 
 #include <gtest/gtest.h>
 
@@ -23,19 +24,8 @@ namespace ht = hexpeel::testing;
 
 namespace {
 
-struct Prepared {
-  QuadSurface surface;
-  ChordSet chords;
-  EdgeGeometry edges;
-};
-
-Prepared prepare(const QuadSurface& s) {
-  Prepared p{s, {}, {}};
-  QuadAdjacency adj = build_adjacency(p.surface);
-  p.chords = find_chords(p.surface, adj);
-  p.edges = classify_edges(p.surface, adj, 60.0);
-  return p;
-}
+using ht::Prepared;
+using ht::prepare;
 
 /// The greedy plan's steps as (chord, side, concave) triples.
 using Signature = std::vector<std::tuple<int32_t, int, bool>>;

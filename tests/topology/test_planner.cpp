@@ -6,6 +6,7 @@
 #include "hexpeel/planner.h"
 #include "hexpeel/reconstruction.h"
 #include "support/generators.h"
+#include "support/prepared.h"
 
 #include <gtest/gtest.h>
 
@@ -17,19 +18,8 @@ namespace ht = hexpeel::testing;
 
 namespace {
 
-struct Prepared {
-  QuadSurface surface;
-  ChordSet chords;
-  EdgeGeometry edges;
-};
-
-Prepared prepare(const QuadSurface& s) {
-  Prepared p{s, {}, {}};
-  QuadAdjacency adj = build_adjacency(p.surface);
-  p.chords = find_chords(p.surface, adj);
-  p.edges = classify_edges(p.surface, adj, 60.0);
-  return p;
-}
+using ht::Prepared;
+using ht::prepare;
 
 PlannerParams convex_only() {
   // The planner's own behaviour, without concave steps (their intrusions are tested elsewhere).
