@@ -1,5 +1,6 @@
 // hexpeel_scaling: time per stage and peak memory on cubed spheres with 6 n^2 quads, and the
-// fitted growth exponent of each stage's time against the quad count. Prints figures only.
+// fitted growth exponent of each stage's time against the quad count (no pillowing or
+// untangling: see hexpeel_untangle_bench). Prints figures only.
 #include "bench_util.h"
 #include "hexpeel/pipeline.h"
 #include "support/generators.h"
@@ -30,7 +31,13 @@ int main(int argc, char** argv) {
       PolygonSoup soup;
       soup.points = g.surface.points;
       for (const Quad& q : g.surface.quads) soup.add_face({q[0], q[1], q[2], q[3]});
-      MeshResult m = run_mesh(soup);
+      // The combinatorial stages and the initial placement; untangling has its own benchmark
+      // (hexpeel_untangle_bench scaling).
+      MeshParams p;
+      p.pillow.mode = PillowMode::none;
+      p.untangle.untangle = false;
+      p.untangle.optimize = false;
+      MeshResult m = run_mesh(soup, p);
       nlohmann::json j = to_json(m);
       j["quads"] = g.surface.num_quads();
       return j;

@@ -33,7 +33,9 @@ struct PlannerParams {
   int beam_moves = 4;           ///< moves expanded per state
   int restarts = 8;             ///< randomized restarts after the beam
   double noise = 0.3;           ///< priority noise of restarts (in weight units)
-  bool improve = true;          ///< after a first plan, run beam and restarts for a cheaper one
+  /// When the first plan needed backtracking, run beam and restarts for a cheaper one too (they
+  /// always run when greedy with backtracking found no plan).
+  bool improve = true;
 };
 
 struct PlannerStats {

@@ -328,7 +328,9 @@ PlannerResult run_planner(EliminationState& state, const PlannerParams& params, 
   Search s(state, params, ctx);
   // 1. cost-guided greedy with windowed backtracking
   if (s.greedy_with_window(0, "window")) s.unwind();
-  if (params.improve || s.best.empty()) {
+  // Beam and restarts look for a plan when greedy found none, and for a cheaper one when the
+  // greedy plan needed rescuing (its tail came from backtracking, not from the priorities).
+  if (s.best.empty() || (params.improve && s.stats.stuck_events > 0)) {
     // 2. beam search
     if (!s.aborted) s.beam();
     // 3. randomized restarts
