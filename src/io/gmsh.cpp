@@ -374,11 +374,7 @@ std::string write_gmsh(const HexMesh& mesh) {
   s += '\n';
   for (int64_t v = 1; v <= np; ++v) (append_int(s, v), s += '\n');
   for (const Vec3& p : mesh.points) {
-    append_real(s, p.x());
-    s += ' ';
-    append_real(s, p.y());
-    s += ' ';
-    append_real(s, p.z());
+    append_point(s, p);
     s += '\n';
   }
   s += "$EndNodes\n$Elements\n1 ";

@@ -256,6 +256,14 @@ bool ByteCursor::get_int(Scalar s, int64_t& v) {
 // ---------------------------------------------------------------------------------------------
 // Formatting
 
+void append_point(std::string& out, const Vec3& p) {
+  append_real(out, p.x());
+  out += ' ';
+  append_real(out, p.y());
+  out += ' ';
+  append_real(out, p.z());
+}
+
 void append_real(std::string& out, double v) {
   char buf[40];
   const auto r = std::to_chars(buf, buf + sizeof(buf), v);

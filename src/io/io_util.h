@@ -155,6 +155,8 @@ class ByteCursor {
 
 /// Shortest text that reads back to the same double (std::to_chars), appended.
 void append_real(std::string& out, double v);
+/// "x y z" of a point, each coordinate as append_real writes it (no newline).
+void append_point(std::string& out, const Vec3& p);
 void append_int(std::string& out, int64_t v);
 
 Status read_whole_file(const std::filesystem::path& path, std::string& out);

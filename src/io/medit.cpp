@@ -115,11 +115,7 @@ std::string write_medit(const HexMesh& mesh) {
   append_int(s, mesh.num_points());
   s += '\n';
   for (const Vec3& p : mesh.points) {
-    append_real(s, p.x());
-    s += ' ';
-    append_real(s, p.y());
-    s += ' ';
-    append_real(s, p.z());
+    append_point(s, p);
     s += " 0\n";
   }
   s += "\nHexahedra\n";

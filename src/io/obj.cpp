@@ -55,11 +55,7 @@ std::string write_obj(const QuadSurface& surface) {
   std::string s = "# quad surface written by hexpeel\n";
   for (const Vec3& p : surface.points) {
     s += "v ";
-    append_real(s, p.x());
-    s += ' ';
-    append_real(s, p.y());
-    s += ' ';
-    append_real(s, p.z());
+    append_point(s, p);
     s += '\n';
   }
   for (const Quad& q : surface.quads) {

@@ -64,11 +64,7 @@ std::string write_off(const QuadSurface& surface) {
   append_int(s, surface.num_quads());
   s += " 0\n";
   for (const Vec3& p : surface.points) {
-    append_real(s, p.x());
-    s += ' ';
-    append_real(s, p.y());
-    s += ' ';
-    append_real(s, p.z());
+    append_point(s, p);
     s += '\n';
   }
   for (const Quad& q : surface.quads) {

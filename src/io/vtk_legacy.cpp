@@ -248,11 +248,7 @@ std::string write_vtk_legacy(const HexMesh& mesh) {
   append_int(s, np);
   s += " double\n";
   for (const Vec3& p : mesh.points) {
-    append_real(s, p.x());
-    s += ' ';
-    append_real(s, p.y());
-    s += ' ';
-    append_real(s, p.z());
+    append_point(s, p);
     s += '\n';
   }
   s += "CELLS ";

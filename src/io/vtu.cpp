@@ -402,11 +402,7 @@ std::string write_vtu(const HexMesh& mesh) {
        "        <DataArray type=\"Float64\" Name=\"Points\" NumberOfComponents=\"3\" format=\"ascii\">\n";
   for (const Vec3& p : mesh.points) {
     s += "          ";
-    append_real(s, p.x());
-    s += ' ';
-    append_real(s, p.y());
-    s += ' ';
-    append_real(s, p.z());
+    append_point(s, p);
     s += '\n';
   }
   s += "        </DataArray>\n      </Points>\n      <Cells>\n"
