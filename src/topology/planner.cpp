@@ -71,15 +71,25 @@ struct Search {
   std::vector<Step> best;
   double best_cost = std::numeric_limits<double>::infinity();
   std::vector<Step> deepest_stuck;
-  bool aborted = false;
+  bool aborted = false;       ///< the current phase (or the whole budget) ran out
+  double phase_end_s = 0.0;   ///< end of the current phase, seconds from start
 
   double elapsed() const { return std::chrono::duration<double>(Clock::now() - start).count(); }
   bool out_of_time() {
-    if (!aborted && elapsed() > params.budget_s) {
+    if (!aborted && elapsed() > std::min(phase_end_s, params.budget_s)) {
       aborted = true;
       stats.budget_exhausted = true;
     }
     return aborted;
+  }
+  /// Starts a phase that may use up to `fraction` of the whole budget from now; false when the
+  /// budget is spent. Phases keep one strategy (a deep windowed search) from starving the others.
+  bool begin_phase(double fraction) {
+    const double now = elapsed();
+    if (now >= params.budget_s) return false;
+    aborted = false;
+    phase_end_s = std::min(params.budget_s, now + fraction * params.budget_s);
+    return true;
   }
   bool done() const { return st.alive_chords() <= 3; }
   /// Hexes the step adds, plus the flat penalty. A concave step's virtual hexes count as cost
@@ -326,16 +336,19 @@ PlannerResult run_planner(EliminationState& state, const PlannerParams& params, 
       return res;
     }
   Search s(state, params, ctx);
-  // 1. cost-guided greedy with windowed backtracking
+  // 1. cost-guided greedy with windowed backtracking (at most 40% of the budget)
+  s.begin_phase(0.4);
   if (s.greedy_with_window(0, "window")) s.unwind();
   // Beam and restarts look for a plan when greedy found none, and for a cheaper one when the
   // greedy plan needed rescuing (its tail came from backtracking, not from the priorities).
   if (s.best.empty() || (params.improve && s.stats.stuck_events > 0)) {
-    // 2. beam search
-    if (!s.aborted) s.beam();
-    // 3. randomized restarts
+    // 2. beam search (at most 20% of the budget)
+    if (s.begin_phase(0.2)) s.beam();
+    // 3. randomized restarts, sharing what is left
     uint64_t seeder = params.seed;
-    for (int r = 0; r < params.restarts && !s.aborted; ++r) {
+    for (int r = 0; r < params.restarts; ++r) {
+      const double left = params.budget_s - s.elapsed();
+      if (left <= 0 || !s.begin_phase(left / (params.restarts - r) / params.budget_s)) break;
       uint64_t noise_seed = splitmix(seeder) | 1;
       if (s.greedy_with_window(noise_seed, "restart")) s.unwind();
       if (!params.improve && !s.best.empty()) break;
