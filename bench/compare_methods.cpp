@@ -33,13 +33,6 @@ std::string fmt(double v, const char* f = "%.3f") {
   return buf;
 }
 
-PolygonSoup soup_of(const QuadSurface& s) {
-  PolygonSoup soup;
-  soup.points = s.points;
-  for (const Quad& q : s.quads) soup.add_face({q[0], q[1], q[2], q[3]});
-  return soup;
-}
-
 struct Variant {
   std::string name;
   MeshParams params;
@@ -155,7 +148,7 @@ int main(int argc, char** argv) {
     for (ht::Generated& g : gs) {
       auto surf = std::make_shared<QuadSurface>(std::move(g.surface));
       cases.push_back({"gen:" + g.name, true, [surf](PolygonSoup& s) {
-                         s = soup_of(*surf);
+                         s = to_polygon_soup(*surf);
                          return surf->num_quads() > 0;
                        }});
     }

@@ -28,9 +28,7 @@ int main(int argc, char** argv) {
   for (int n : ns) {
     bench::Isolated r = bench::run_isolated([n]() {
       ht::Generated g = ht::cubed_sphere_equiangular(n);
-      PolygonSoup soup;
-      soup.points = g.surface.points;
-      for (const Quad& q : g.surface.quads) soup.add_face({q[0], q[1], q[2], q[3]});
+      PolygonSoup soup = to_polygon_soup(g.surface);
       // The combinatorial stages and the initial placement; untangling has its own benchmark
       // (hexpeel_untangle_bench scaling).
       MeshParams p;

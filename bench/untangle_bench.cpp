@@ -24,13 +24,6 @@ namespace {
 
 using namespace hexpeel;
 
-PolygonSoup soup_of(const QuadSurface& s) {
-  PolygonSoup soup;
-  soup.points = s.points;
-  for (const Quad& q : s.quads) soup.add_face({q[0], q[1], q[2], q[3]});
-  return soup;
-}
-
 void mesh_row(const std::string& name, const PolygonSoup& soup, const MeshParams& base) {
   MeshParams p0 = base;
   p0.untangle.untangle = p0.untangle.optimize = false;
@@ -115,7 +108,7 @@ int main(int argc, char** argv) {
         gs.push_back(perturbed(cubed_sphere_equiangular(6), seed, 0.2));
       for (const Generated& g : gs) {
         if (g.surface.quads.empty()) continue;
-        mesh_row(g.name, soup_of(g.surface), params);
+        mesh_row(g.name, to_polygon_soup(g.surface), params);
       }
     }
   }

@@ -41,6 +41,10 @@ struct QuadSurface {
   int32_t num_quads() const { return static_cast<int32_t>(quads.size()); }
 };
 
+/// The surface as polygons (what a reader would give), e.g. to run the pipeline on a generated
+/// surface.
+PolygonSoup to_polygon_soup(const QuadSurface& surface);
+
 /// Half-edge adjacency of a closed quad surface, built in one pass.
 /// opposite[4*q+k] is the half-edge of the neighbouring quad across edge k of q, or -1 when the
 /// edge is a boundary or non-manifold edge (validation rejects those).

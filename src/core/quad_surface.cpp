@@ -7,6 +7,14 @@
 
 namespace hexpeel {
 
+PolygonSoup to_polygon_soup(const QuadSurface& surface) {
+  PolygonSoup soup;
+  soup.points = surface.points;
+  soup.indices.reserve(4 * surface.quads.size());
+  for (const Quad& q : surface.quads) soup.add_face({q[0], q[1], q[2], q[3]});
+  return soup;
+}
+
 QuadAdjacency build_adjacency(const QuadSurface& surface) {
   const int32_t nq = surface.num_quads();
   // Sort half-edges by their undirected key; runs of equal keys are the edges.

@@ -154,6 +154,19 @@ double quick_weight_key(const EliminationState& state, int32_t chord, const Chor
                   side_key(state, w, 1, state.side_size(chord, 1), p));
 }
 
+/// Tier of a convex move (kremer): sets m.zero_volume; m.flat and m.waits must be set.
+double convex_tier(const EliminationState& state, const ChordWeights& w, const OrderParams& p,
+                   Move& m) {
+  m.zero_volume = p.zero_volume && has_zero_volume(state, m.chord, p.zero_volume_tolerance_deg);
+  double tier = kTierConvex;
+  if (p.concave && w.convex[0] >= p.both_convex_min && w.convex[1] >= p.both_convex_min)
+    tier += kTierBothConvex;
+  if (m.zero_volume) tier += kTierZeroVolume;
+  if (m.waits) tier += kTierWaits;
+  if (m.flat) tier += kTierFlat;
+  return tier;
+}
+
 }  // namespace
 
 Move OrderPolicy::quick(const EliminationState& state, int32_t chord) const {
@@ -171,14 +184,7 @@ Move OrderPolicy::quick(const EliminationState& state, int32_t chord) const {
     m.key = {0.0, -concavity, static_cast<double>(w.length), static_cast<double>(chord)};
     return m;
   }
-  m.zero_volume = params_.zero_volume &&
-                  has_zero_volume(state, chord, params_.zero_volume_tolerance_deg);
-  double tier = kTierConvex;
-  if (params_.concave && w.convex[0] >= params_.both_convex_min &&
-      w.convex[1] >= params_.both_convex_min)
-    tier += kTierBothConvex;
-  if (m.zero_volume) tier += kTierZeroVolume;
-  if (m.flat) tier += kTierFlat;
+  const double tier = convex_tier(state, w, params_, m);
   m.key = {tier, quick_weight_key(state, chord, w, params_), static_cast<double>(w.length),
            static_cast<double>(chord)};
   return m;
@@ -250,15 +256,7 @@ Move OrderPolicy::full(const EliminationState& state, int32_t chord, std::array<
     weight_key = -w.sharp[side];
   }
   m.side = static_cast<int8_t>(side);
-  m.zero_volume = params_.zero_volume &&
-                  has_zero_volume(state, chord, params_.zero_volume_tolerance_deg);
-  double tier = kTierConvex;
-  if (params_.concave && w.convex[0] >= params_.both_convex_min &&
-      w.convex[1] >= params_.both_convex_min)
-    tier += kTierBothConvex;
-  if (m.zero_volume) tier += kTierZeroVolume;
-  if (m.waits) tier += kTierWaits;
-  if (m.flat) tier += kTierFlat;
+  const double tier = convex_tier(state, w, params_, m);
   m.key = {tier, weight_key, static_cast<double>(w.length), static_cast<double>(chord)};
   return m;
 }

@@ -33,13 +33,6 @@ HexComplex complex_of(const Generated& g) {
   return c;
 }
 
-PolygonSoup soup_of(const QuadSurface& s) {
-  PolygonSoup soup;
-  soup.points = s.points;
-  for (const Quad& q : s.quads) soup.add_face({q[0], q[1], q[2], q[3]});
-  return soup;
-}
-
 TEST(GeometryUntangle, JitteredGridBecomesPositiveAndBoundaryStays) {
   for (uint64_t seed : {1u, 2u, 3u}) {
     SCOPED_TRACE("seed " + std::to_string(seed));
@@ -157,7 +150,7 @@ TEST(GeometryPipeline, GeneratedSurfacesMeshAllPositive) {
   int meshed = 0;
   for (const Generated& g : gs) {
     SCOPED_TRACE(g.name);
-    MeshResult r = run_mesh(soup_of(g.surface));
+    MeshResult r = run_mesh(to_polygon_soup(g.surface));
     if (r.status.code == StatusCode::stuck) continue;  // elimination's business, not geometry's
     ++meshed;
     ASSERT_TRUE(r.status.ok()) << to_string(r.status);
@@ -173,7 +166,7 @@ TEST(GeometryPipeline, GeneratedSurfacesMeshAllPositive) {
 }
 
 TEST(GeometryPipeline, CubeGridStaysPerfect) {
-  MeshResult r = run_mesh(soup_of(testing::cube(3, 3, 3).surface));
+  MeshResult r = run_mesh(to_polygon_soup(testing::cube(3, 3, 3).surface));
   ASSERT_TRUE(r.status.ok()) << to_string(r.status);
   EXPECT_GE(r.quality.sj_min, 0.99);
 }

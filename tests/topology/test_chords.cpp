@@ -236,13 +236,6 @@ TEST(Diagnosis, InvalidSurfaceKeepsValidationStatus) {
   EXPECT_TRUE(contains(to_text(d), "error open_boundary: ")) << to_text(d);
 }
 
-PolygonSoup soup_of(const QuadSurface& surface) {
-  PolygonSoup soup;
-  soup.points = surface.points;
-  for (const Quad& q : surface.quads) soup.add_face({q[0], q[1], q[2], q[3]});
-  return soup;
-}
-
 std::vector<testing::Generated> generated_surfaces() {
   using namespace testing;
   std::vector<Generated> gs{cube(1, 1, 1), cube(2, 3, 4), cube(3, 3, 3, 0.01), cubed_sphere(4),
@@ -259,7 +252,7 @@ TEST(Generated, ValidAndChordsMatchTheGenerator) {
   for (const testing::Generated& g : generated_surfaces()) {
     SCOPED_TRACE(g.name);
     if (g.surface.quads.empty()) continue;  // generator declined (documented behaviour)
-    const SurfaceDiagnosis d = diagnose_surface(soup_of(g.surface));
+    const SurfaceDiagnosis d = diagnose_surface(to_polygon_soup(g.surface));
     ASSERT_TRUE(d.status.ok()) << to_string(d.status);
     EXPECT_FALSE(d.validation.stats.flipped);
     EXPECT_EQ(d.validation.surface.quads, g.surface.quads);  // ids and corner order kept

@@ -41,13 +41,6 @@ Signature plan_of(const Prepared& p, const OrderParams& order, EliminationPlan* 
   return sig;
 }
 
-PolygonSoup soup_of(const QuadSurface& s) {
-  PolygonSoup soup;
-  soup.points = s.points;
-  for (const Quad& q : s.quads) soup.add_face({q[0], q[1], q[2], q[3]});
-  return soup;
-}
-
 /// Greedy (no search), simple placement: what the order rules and the reconstruction do.
 MeshParams greedy_params(const OrderParams& order) {
   MeshParams mp;
@@ -163,7 +156,7 @@ TEST(Order, ConcaveWaitsForEnclosedRuleChangesTheOrder) {
 TEST(Reconstruction, IntrusionGivesABallWithTheInputBoundary) {
   for (int m = 1; m <= 2; ++m) {
     ht::Generated g = ht::named_solid("pocket", m);
-    MeshResult r = run_mesh(soup_of(g.surface), greedy_params(kremer()));
+    MeshResult r = run_mesh(to_polygon_soup(g.surface), greedy_params(kremer()));
     ASSERT_TRUE(r.status.ok()) << g.name << ": " << to_string(r.status);
     EXPECT_GT(r.plan.stats.concave_steps, 0) << g.name;
     EXPECT_EQ(r.reconstruction.intrusions, r.plan.stats.concave_steps) << g.name;
@@ -194,7 +187,7 @@ TEST(Reconstruction, InvalidIntrusionIsReportedWithNoMesh) {
     ht::Generated g = ht::named_solid(shape, 2);
     MeshParams strict = greedy_params(loose);
     strict.reconstruction.fallback_to_extrusion = false;
-    MeshResult r = run_mesh(soup_of(g.surface), strict);
+    MeshResult r = run_mesh(to_polygon_soup(g.surface), strict);
     if (r.status.code != StatusCode::invalid_intrusion) {
       EXPECT_TRUE(r.status.ok() || r.status.code == StatusCode::stuck) << g.name << ": " << to_string(r.status);
       continue;
@@ -206,7 +199,7 @@ TEST(Reconstruction, InvalidIntrusionIsReportedWithNoMesh) {
     // The same plan with the fallback: the step is extruded, the mesh is valid.
     MeshParams fb = greedy_params(loose);
     fb.reconstruction.fallback_to_extrusion = true;
-    MeshResult f = run_mesh(soup_of(g.surface), fb);
+    MeshResult f = run_mesh(to_polygon_soup(g.surface), fb);
     ASSERT_TRUE(f.status.ok()) << g.name << ": " << to_string(f.status);
     EXPECT_FALSE(f.reconstruction.invalid_intrusion_steps.empty());
     QualityReport q = run_quality(f.mesh, {}, &g.surface);
@@ -226,8 +219,8 @@ TEST(Order, KremerOnVoxelSolidsMeshesWhatOriginalMeshes) {
   int ok[2] = {0, 0}, good[2] = {0, 0};
   int64_t singular[2] = {0, 0};
   for (const ht::Generated& g : gs) {
-    MeshResult a = run_mesh(soup_of(g.surface), greedy_params(orig));
-    MeshResult b = run_mesh(soup_of(g.surface), kp);
+    MeshResult a = run_mesh(to_polygon_soup(g.surface), greedy_params(orig));
+    MeshResult b = run_mesh(to_polygon_soup(g.surface), kp);
     ok[0] += a.status.ok(), ok[1] += b.status.ok();
     if (a.status.ok()) {
       good[0] += a.quality.sj_count_nonpositive == 0;

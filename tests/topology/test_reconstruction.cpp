@@ -20,13 +20,6 @@ namespace ht = hexpeel::testing;
 
 namespace {
 
-PolygonSoup soup_of(const QuadSurface& s) {
-  PolygonSoup soup;
-  soup.points = s.points;
-  for (const Quad& q : s.quads) soup.add_face({q[0], q[1], q[2], q[3]});
-  return soup;
-}
-
 struct Outcome {
   bool meshed = false, stuck = false;
   std::string failure;  // non-empty: an invalid result (test failure)
@@ -37,7 +30,7 @@ Outcome mesh_and_check(const QuadSurface& surface) {
   Outcome o;
   MeshParams params;
   params.reconstruction.verify_each_step = true;
-  MeshResult r = run_mesh(soup_of(surface), params);
+  MeshResult r = run_mesh(to_polygon_soup(surface), params);
   if (r.status.code == StatusCode::stuck) {
     o.stuck = true;
     if (!r.mesh.hexes.empty()) o.failure = "stuck but a mesh was produced";
