@@ -1,11 +1,15 @@
 // Untangling / optimization / pillowing figures: a markdown table per run, never an assertion.
 //
 //   hexpeel_untangle_bench mesh FILE... [--pillow auto|all|none] [--greedy] [--family]
+//                                       [--solver newton|lbfgs] [--simplicial]
 //       full pipeline on each surface file (and with --family on generated surfaces): hexes,
 //       forced configurations, min/mean SJ after placement and after each phase, times.
-//   hexpeel_untangle_bench scaling [--sizes 10,22,46] [--threads N]
+//   hexpeel_untangle_bench scaling [--sizes 10,22,46] [--threads N] [--solver newton|lbfgs]
+//                                  [--simplicial]
 //       the optimizer alone on jittered equiangular cubed spheres of n^3 hexes: time per phase,
-//       evaluations, vertex-evaluations per second.
+//       iterations / evaluations (Newton: also factorizations and the time spent assembling,
+//       factorizing and solving), vertex-evaluations per second.
+//   Run both --solver values to compare L-BFGS and Newton on the same machine.
 #include "hexpeel/pipeline.h"
 #include "hexpeel/io.h"
 #include "hexpeel/untangle.h"
@@ -37,13 +41,14 @@ void mesh_row(const std::string& name, const PolygonSoup& soup, const MeshParams
   const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
   const UntangleStats& u = r.untangle;
   std::printf("| %s | %d | %d (%dd/%dc/%df) | %d+%d%s | %.3f / %.3f (%d<=0) | %.3f (%d<=0) | "
-              "%.3f / %.3f (%d<=0) | %.2f+%.2f s | %.2f s |\n",
+              "%.3f / %.3f (%d<=0) | %d/%d | %.2f+%.2f s | %.2f s |\n",
               name.c_str(), r.quality.hexes, r.pillow.forced, r.pillow.flat_doublets,
               r.pillow.concave_corners, r.pillow.fixed_corners, r.pillow.shrink_set,
               r.pillow.new_hexes, r.pillow.whole_boundary ? " whole" : "", r0.quality.sj_min,
               r0.quality.sj_mean, r0.quality.sj_count_nonpositive, u.untangle.min_sj_after,
               u.untangle.nonpositive_after, r.quality.sj_min, r.quality.sj_mean,
-              r.quality.sj_count_nonpositive, u.untangle.time_s, u.optimize.time_s, total);
+              r.quality.sj_count_nonpositive, u.untangle.rounds, u.untangle.iterations,
+              u.untangle.time_s, u.optimize.time_s, total);
   std::fflush(stdout);
 }
 
@@ -71,21 +76,36 @@ int main(int argc, char** argv) {
   scaling->add_option("--sizes", sizes, "n of the n^3-hex meshes")->delimiter(',');
   scaling->add_option("--threads", threads, "TBB threads (0 = default)");
   scaling->add_option("--jitter", jitter, "jittered() amount")->capture_default_str();
+  std::string solver = "lbfgs";
+  bool simplicial = false;
+  for (auto* sub : {mesh, scaling}) {
+    sub->add_option("--solver", solver, "phase 1 minimizer: newton|lbfgs")->capture_default_str();
+    sub->add_flag("--simplicial", simplicial, "Newton: CHOLMOD simplicial instead of supernodal");
+  }
   CLI11_PARSE(app, argc, argv);
+  UntangleParams up;
+  if (!parse_untangle_solver(solver, up.solver)) {
+    std::fprintf(stderr, "unknown --solver %s\n", solver.c_str());
+    return 1;
+  }
+  up.supernodal = !simplicial;
   std::unique_ptr<tbb::global_control> gc;
   if (threads > 0)
     gc = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
 
   if (*mesh) {
     MeshParams params;
+    params.untangle = up;
     params.search = !greedy;
     params.pillow.forced_sj = forced_sj;
     params.pillow.grow = grow;
     params.pillow.mode = pillow == "all" ? PillowMode::all
                          : pillow == "none" ? PillowMode::none : PillowMode::automatic;
-    std::printf("pillow %s\n\n| surface | hexes | forced (doublet/concave/fixed) | pillow set+new "
-                "| placed min / mean | untangled min | final min / mean | untangle+opt | total |\n"
-                "|---|---|---|---|---|---|---|---|---|\n", pillow.c_str());
+    std::printf("pillow %s, solver %s%s\n\n| surface | hexes | forced (doublet/concave/fixed) | "
+                "pillow set+new | placed min / mean | untangled min | final min / mean | "
+                "untangle rounds/iters | untangle+opt | total |\n"
+                "|---|---|---|---|---|---|---|---|---|---|\n", pillow.c_str(), solver.c_str(),
+                solver == "newton" ? (simplicial ? " (simplicial)" : " (supernodal)") : "");
     for (const std::string& f : files) {
       PolygonSoup soup;
       Status st = read_surface(f, soup);
@@ -113,22 +133,27 @@ int main(int argc, char** argv) {
     }
   }
   if (*scaling) {
-    std::printf("| hexes | free vertices | forced (<=0) | placed min | untangle: rounds/evals/time | min | "
-                "optimize: rounds/evals/time | min | vertex-evals/s |\n|---|---|---|---|---|---|---|---|---|\n");
+    std::printf("solver %s%s\n\n| hexes | free vertices | forced (<=0) | placed min | "
+                "untangle: rounds/iters/evals/factorizations | untangle time (solve) | min | "
+                "optimize: rounds/evals/time | min | total | vertex-evals/s |\n"
+                "|---|---|---|---|---|---|---|---|---|---|---|\n", solver.c_str(),
+                solver == "newton" ? (simplicial ? " (simplicial)" : " (supernodal)") : "");
     for (int n : sizes) {
       testing::Generated g = testing::jittered(testing::cubed_sphere_equiangular(n), 7, jitter);
       HexMesh m = g.known_mesh;
       std::vector<uint8_t> fixed(m.points.size(), 0);
       for (int32_t v = 0; v < g.surface.num_points(); ++v) fixed[v] = 1;
-      UntangleResult u = run_untangle(m, fixed);
+      UntangleResult u = run_untangle(m, fixed, up);
       const UntangleStats& s = u.stats;
       const double evals = s.untangle.evaluations + s.optimize.evaluations;
-      std::printf("| %d | %d | %d (%d) | %.3f (%d<=0) | %d/%d/%.2f s | %.3f | %d/%d/%.2f s | %.3f | %.3g |\n",
+      std::printf("| %d | %d | %d (%d) | %.3f (%d<=0) | %d/%d/%d/%d | %.2f s (%.2f s) | %.3f (%d<=0) | "
+                  "%d/%d/%.2f s | %.3f (%d<=0) | %.2f s | %.3g |\n",
                   m.num_hexes(), s.free_vertices, s.forced_corners, s.forced_nonpositive,
-                  s.untangle.min_sj_before,
-                  s.untangle.nonpositive_before, s.untangle.rounds, s.untangle.evaluations,
-                  s.untangle.time_s, s.untangle.min_sj_after, s.optimize.rounds,
-                  s.optimize.evaluations, s.optimize.time_s, s.optimize.min_sj_after,
+                  s.untangle.min_sj_before, s.untangle.nonpositive_before, s.untangle.rounds,
+                  s.untangle.iterations, s.untangle.evaluations, s.untangle.factorizations,
+                  s.untangle.time_s, s.untangle.solve_time_s, s.untangle.min_sj_after,
+                  s.untangle.nonpositive_after, s.optimize.rounds, s.optimize.evaluations,
+                  s.optimize.time_s, s.optimize.min_sj_after, s.optimize.nonpositive_after, s.time_s,
                   evals * s.free_vertices / std::max(1e-9, s.time_s));
       std::fflush(stdout);
     }

@@ -3,9 +3,11 @@
 // Phase 1 (untangle): the regularized Winslow-type energy of Garanzha, Kaporin, Kudryavtseva,
 // Protais, Ray and Sokolov ("Foldover-free maps in 50 lines of code", ACM TOG 2021; "Untangling and
 // optimization of spatial meshes", 2022) on the 8 corner tetrahedra of every hex, with their
-// epsilon continuation, minimized by L-BFGS. Phase 2 (optimize): a smoothed minimum of the corner
-// scaled Jacobians, minimized by L-BFGS whose line search rejects any step that makes a corner
-// non-positive, so no hex positive after phase 1 goes <= 0. Fixed vertices never move (bit for bit).
+// epsilon continuation, minimized by L-BFGS or by Newton's method (per-corner Hessians projected
+// to positive semi-definite, sparse Cholesky by CHOLMOD), see UntangleParams::solver.
+// Phase 2 (optimize): a smoothed minimum of the corner scaled Jacobians, minimized by L-BFGS
+// whose line search rejects any step that makes a corner non-positive, so no hex positive after
+// phase 1 goes <= 0. Fixed vertices never move (bit for bit).
 // Same output for any thread count (fixed partitions, per-vertex sums in a fixed order).
 #pragma once
 
@@ -15,9 +17,19 @@
 
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace hexpeel {
+
+/// Minimizer of phase 1 (the Winslow energy). Phase 2 uses L-BFGS with either.
+enum class UntangleSolver : uint8_t {
+  newton,  ///< projected Newton: PSD-clamped corner Hessians, CHOLMOD factorization, backtracking
+  lbfgs,   ///< L-BFGS (LBFGSpp): cheap iterations, many more of them
+};
+std::string_view to_string(UntangleSolver s);
+/// "newton" or "lbfgs"; false (and `out` untouched) for anything else.
+bool parse_untangle_solver(std::string_view name, UntangleSolver& out);
 
 struct UntangleParams {
   bool untangle = true;   ///< run phase 1 (Winslow energy with epsilon continuation)
@@ -25,11 +37,21 @@ struct UntangleParams {
   /// Weight of the volume term (det^2 + 1) / chi against the shape term tr(J^T J) / chi^(2/3)
   /// (dimensionless, >= 0). det is measured against a cube of the mean hex volume.
   double lambda = 1.0;
+  /// Phase 1 minimizer. L-BFGS is the default: on every mesh measured (issue 6) it was faster than
+  /// Newton, whose CHOLMOD factorizations of a 3D mesh's Hessian fill in heavily, and reached the
+  /// same result (screw2 stays inverted with both).
+  UntangleSolver solver = UntangleSolver::lbfgs;
   int max_outer = 20;             ///< epsilon continuation rounds in phase 1 (1..10000)
   int max_inner = 200;            ///< L-BFGS iterations per round, both phases (1..100000)
   double inner_gtol = 1e-5;       ///< L-BFGS gradient tolerance, relative to |x| (> 0)
   double energy_rtol = 1e-5;      ///< phase 1 stops once all corners are positive and E changes by less
   int lbfgs_memory = 8;           ///< L-BFGS history length (1..100)
+  int max_newton = 30;            ///< Newton iterations per epsilon round (1..10000)
+  /// A Newton round ends when an iteration lowers E by less than this fraction of |E| (> 0).
+  double newton_rtol = 1e-7;
+  /// CHOLMOD factorization: supernodal (BLAS blocks) or simplicial (no BLAS). Same result up to
+  /// rounding; the choice only matters for speed.
+  bool supernodal = true;
   /// Phase 2 minimizes sum exp(beta * (s_min - s)) over the corner scaled Jacobians s: larger beta
   /// focuses harder on the worst corners (dimensionless, 1..200).
   double beta = 30.0;
@@ -46,12 +68,15 @@ struct UntanglePhaseStats {
   int32_t rounds = 0;        ///< outer rounds (epsilon updates / phase 2 restarts)
   int32_t iterations = 0;    ///< L-BFGS iterations, summed over rounds
   int32_t evaluations = 0;   ///< energy + gradient evaluations
+  int32_t factorizations = 0;  ///< Newton: numeric Cholesky factorizations (0 for L-BFGS)
+  double solve_time_s = 0.0;   ///< Newton: Hessian assembly + factorization + solves
   double time_s = 0.0;
   double min_sj_before = 0.0, min_sj_after = 0.0;  ///< min Verdict hex SJ over all hexes
   int32_t nonpositive_before = 0, nonpositive_after = 0;  ///< hexes with SJ <= 0
 };
 
 struct UntangleStats {
+  UntangleSolver solver = UntangleSolver::lbfgs;  ///< phase 1 minimizer used
   int32_t free_vertices = 0;
   int32_t active_corners = 0;   ///< corner tetrahedra in the energy (some point free)
   int32_t forced_corners = 0;   ///< left out: all 4 points fixed, or the fixed ones collinear

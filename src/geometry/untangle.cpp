@@ -7,7 +7,11 @@
 // cube of edge h has J = I). Phase 1 minimizes
 //     sum  tr(J^T J) / chi(det J, eps)^(2/3) + lambda (det^2 + 1) / chi(det J, eps),
 //     chi(D, eps) = (D + sqrt(eps^2 + D^2)) / 2,
-// with the papers' epsilon update after each L-BFGS run (eps follows the worst corner down to 0).
+// with the papers' epsilon update after each inner minimization (eps follows the worst corner
+// down to 0). The inner minimizer is L-BFGS or projected Newton (UntangleParams::solver): the
+// corner Hessians in closed form with negative eigenvalues clamped (untangle_kernels.h),
+// assembled into a sparse matrix over the free vertices, factorized by CHOLMOD (symbolic analysis
+// once per run, numeric factorization per iteration), Armijo backtracking from the full step.
 // Corners whose 4 points are all fixed, or whose fixed points are collinear, cannot change their
 // sign: they are left out of the energy and out of the eps schedule (DESIGN.md "Geometry"),
 // otherwise eps would never reach 0. Phase 2 minimizes sum exp(beta (s_min - s)) over the corner
@@ -17,12 +21,16 @@
 // Input: any hex mesh with finite points; `fixed` marks pinned vertices. Output: the same mesh
 // with free vertices moved; fixed points are copied, never recomputed. Determinism: per-corner
 // terms are written to their own slots, energies summed over fixed blocks in block order, and
-// per-vertex gradients gathered in a fixed incidence order, so any thread count gives the same
-// bytes.
+// per-vertex gradients gathered in a fixed incidence order, the Hessian assembled colour by colour
+// (NewtonSystem), and CHOLMOD does not see the TBB thread count, so any thread count gives the
+// same bytes.
 #include "hexpeel/untangle.h"
+#include "geometry/untangle_kernels.h"
 #include "hexpeel/quality.h"
 
+#include <Eigen/CholmodSupport>
 #include <Eigen/Geometry>
+#include <Eigen/SparseCore>
 #include <LBFGS.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -33,22 +41,30 @@
 #include <limits>
 
 namespace hexpeel {
+
+std::string_view to_string(UntangleSolver s) {
+  return s == UntangleSolver::newton ? "newton" : "lbfgs";
+}
+
+bool parse_untangle_solver(std::string_view name, UntangleSolver& out) {
+  if (name == "newton") out = UntangleSolver::newton;
+  else if (name == "lbfgs") out = UntangleSolver::lbfgs;
+  else return false;
+  return true;
+}
+
 namespace {
 
+using untangle_detail::chi;
+using untangle_detail::Mat12;
+using untangle_detail::Mat9;
+using untangle_detail::QualityKernel;
+using untangle_detail::WinslowKernel;
 using Clock = std::chrono::steady_clock;
 constexpr int32_t kBlock = 2048;  // corners per reduction block (fixed: keeps sums deterministic)
 
 double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
-/// chi(D, eps) in a form that does not cancel for D << 0 (the papers' regularized determinant).
-inline double chi(double d, double eps) {
-  const double r = std::sqrt(eps * eps + d * d);
-  return d > 0 ? 0.5 * (d + r) : 0.5 * eps * eps / (r - d);
-}
-inline double chi_deriv(double d, double eps) {
-  return 0.5 + 0.5 * d / std::sqrt(eps * eps + d * d);
 }
 
 /// The optimization problem on flat arrays.
@@ -59,6 +75,7 @@ struct Problem {
   std::vector<std::array<int32_t, 4>> corners;   ///< active corners: (c, n0, n1, n2) point ids
   std::vector<int32_t> inc_start;                ///< CSR over unknowns: slots 4*corner+k using it
   std::vector<int32_t> inc_slot;
+  std::vector<int32_t> group_start;              ///< corners of one hex: [group_start[i], [i+1])
   // work arrays (sized once, reused by every evaluation)
   std::vector<Vec3> pos;                         ///< current positions of all points
   std::vector<double> corner_f;                  ///< per-corner energy
@@ -123,60 +140,6 @@ struct Problem {
   }
 };
 
-/// Phase 1 kernel: the regularized Winslow + volume energy of one corner tetrahedron.
-struct WinslowKernel {
-  double eps, lambda;
-  double operator()(const Vec3& e0, const Vec3& e1, const Vec3& e2, Vec3& g0, Vec3& g1, Vec3& g2,
-                    double& det) const {
-    const Vec3 d0 = e1.cross(e2), d1 = e2.cross(e0), d2 = e0.cross(e1);  // d det / d e_k
-    det = e0.dot(d0);
-    const double c1 = chi(det, eps), c2 = std::cbrt(c1 * c1), c3 = chi_deriv(det, eps);
-    const double tr = e0.squaredNorm() + e1.squaredNorm() + e2.squaredNorm();
-    const double fw = tr / c2, fv = (det * det + 1.0) / c1;
-    const double kd = -(2.0 / 3.0) * fw * c3 / c1 + lambda * (2.0 * det - fv * c3) / c1;
-    g0 = (2.0 / c2) * e0 + kd * d0;
-    g1 = (2.0 / c2) * e1 + kd * d1;
-    g2 = (2.0 / c2) * e2 + kd * d2;
-    return fw + lambda * fv;
-  }
-};
-
-/// Phase 2 kernel: exp(beta (s_ref - s)) of the corner scaled Jacobian s, +inf below the floor,
-/// plus mu times the phase 1 energy (eps ~ 0). s is scale invariant, so without the second term
-/// an edge can shrink to nothing (a pillow hex collapsing onto the boundary) at no cost; the
-/// volume part (det^2 + 1) / det of the Winslow energy keeps every corner's size.
-struct QualityKernel {
-  double beta, s_ref, floor;  ///< a trial point with s <= floor is rejected (energy +inf)
-  double mu;                  ///< weight of the Winslow regularizer
-  WinslowKernel winslow;
-  double operator()(const Vec3& e0, const Vec3& e1, const Vec3& e2, Vec3& g0, Vec3& g1, Vec3& g2,
-                    double& s) const {
-    const Vec3 d0 = e1.cross(e2), d1 = e2.cross(e0), d2 = e0.cross(e1);
-    const double det = e0.dot(d0);
-    const double a2 = e0.squaredNorm(), b2 = e1.squaredNorm(), c2 = e2.squaredNorm();
-    const double l = std::sqrt(a2 * b2 * c2);
-    if (!(l > 1e-300)) {
-      s = -1.0;
-      g0 = g1 = g2 = Vec3::Zero();
-      return std::numeric_limits<double>::infinity();
-    }
-    s = det / l;
-    if (s <= floor) {
-      g0 = g1 = g2 = Vec3::Zero();
-      return std::numeric_limits<double>::infinity();
-    }
-    const double f = std::exp(beta * (s_ref - s));
-    const double k = -beta * f;  // df/ds
-    Vec3 w0, w1, w2;
-    double wdet;
-    const double fw = winslow(e0, e1, e2, w0, w1, w2, wdet);
-    g0 = k * (d0 / l - (s / a2) * e0) + mu * w0;
-    g1 = k * (d1 / l - (s / b2) * e1) + mu * w1;
-    g2 = k * (d2 / l - (s / c2) * e2) + mu * w2;
-    return f + mu * fw;
-  }
-};
-
 /// Runs L-BFGS on `kernel` from x; x ends at the lowest finite energy seen. Returns iterations.
 template <typename Kernel>
 int minimize(Problem& prob, const Kernel& kernel, Eigen::VectorXd& x, const UntangleParams& p,
@@ -210,6 +173,225 @@ int minimize(Problem& prob, const Kernel& kernel, Eigen::VectorXd& x, const Unta
   }
   if (std::isfinite(best)) x = best_x;
   return iters;
+}
+
+/// The assembled Hessian over the unknowns (upper triangle, CSC, as CHOLMOD wants) and its
+/// factorization. The pattern and the symbolic analysis are computed once; every Newton iteration
+/// refills the values and refactorizes. Assembly is deterministic without per-corner storage:
+/// hexes (corner groups) are coloured so that two groups of one colour share no free vertex;
+/// colours run in a fixed order, the groups of one colour in parallel, so every matrix entry
+/// receives its contributions in the same order for any thread count.
+struct NewtonSystem {
+  Eigen::SparseMatrix<double> h;                  ///< 3nu x 3nu, upper triangle
+  /// Per corner, per point pair (a <= b, kPairs order): the value index of the first row of the
+  /// 3x3 block in each of its 3 columns, or -1 when a point is fixed. 
+  std::vector<std::array<std::array<int32_t, 3>, 10>> corner_block;
+  std::vector<std::array<uint8_t, 10>> corner_swap;  ///< block stored transposed (unknown a > b)
+  std::vector<int32_t> color_start;               ///< groups of colour c: color_groups[cs[c], cs[c+1])
+  std::vector<int32_t> color_groups;
+  std::vector<int32_t> diag_index;                ///< value index of each diagonal entry
+  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Upper> supernodal;
+  Eigen::CholmodSimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Upper> simplicial;
+  bool use_supernodal = true;
+  bool analyzed = false;
+
+  static constexpr int kPairs[10][2] = {{0, 0}, {0, 1}, {0, 2}, {0, 3}, {1, 1},
+                                        {1, 2}, {1, 3}, {2, 2}, {2, 3}, {3, 3}};
+
+  void build(const Problem& prob, bool supernodal_mode) {
+    use_supernodal = supernodal_mode;
+    const int32_t nu = static_cast<int32_t>(prob.free_point.size()), nc = prob.num_corners();
+    std::vector<Eigen::Triplet<double>> trip;
+    trip.reserve(static_cast<size_t>(nc) * 45);
+    for (const auto& k : prob.corners)
+      for (const auto& pr : kPairs) {
+        int32_t ua = prob.free_index[k[pr[0]]], ub = prob.free_index[k[pr[1]]];
+        if (ua < 0 || ub < 0) continue;
+        if (ua > ub) std::swap(ua, ub);
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j)
+            if (ua < ub || i <= j) trip.emplace_back(3 * ua + i, 3 * ub + j, 0.0);
+      }
+    h.resize(3 * nu, 3 * nu);
+    h.setFromTriplets(trip.begin(), trip.end());
+    h.makeCompressed();
+    auto index_of = [&](int32_t row, int32_t col) {
+      const int32_t* b = h.innerIndexPtr() + h.outerIndexPtr()[col];
+      const int32_t* e = h.innerIndexPtr() + h.outerIndexPtr()[col + 1];
+      const int32_t* it = std::lower_bound(b, e, row);
+      HEXPEEL_ASSERT(it != e && *it == row);
+      return static_cast<int32_t>(it - h.innerIndexPtr());
+    };
+    corner_block.assign(nc, {});
+    corner_swap.assign(nc, {});
+    for (int32_t c = 0; c < nc; ++c) {
+      const auto& k = prob.corners[c];
+      for (int p = 0; p < 10; ++p) {
+        const int32_t ua = prob.free_index[k[kPairs[p][0]]], ub = prob.free_index[k[kPairs[p][1]]];
+        auto& blk = corner_block[c][p];
+        if (ua < 0 || ub < 0) {
+          blk = {-1, -1, -1};
+          continue;
+        }
+        const int32_t r = std::min(ua, ub), col = std::max(ua, ub);
+        corner_swap[c][p] = ua > ub;
+        for (int j = 0; j < 3; ++j) blk[j] = index_of(3 * r, 3 * col + j);
+      }
+    }
+    diag_index.resize(3 * nu);
+    for (int32_t i = 0; i < 3 * nu; ++i) diag_index[i] = index_of(i, i);
+    // Greedy colouring of the corner groups by shared free vertices, in group order.
+    const int32_t ng = static_cast<int32_t>(prob.group_start.size()) - 1;
+    std::vector<int32_t> vg_start(nu + 1, 0), vg;
+    auto for_free = [&](int32_t g, auto&& fn) {
+      for (int32_t c = prob.group_start[g]; c < prob.group_start[g + 1]; ++c)
+        for (int32_t v : prob.corners[c])
+          if (prob.free_index[v] >= 0) fn(prob.free_index[v]);
+    };
+    for (int32_t g = 0; g < ng; ++g) for_free(g, [&](int32_t u) { ++vg_start[u + 1]; });
+    for (int32_t u = 0; u < nu; ++u) vg_start[u + 1] += vg_start[u];
+    vg.resize(vg_start[nu]);
+    {
+      std::vector<int32_t> fill(vg_start.begin(), vg_start.end() - 1);
+      for (int32_t g = 0; g < ng; ++g) for_free(g, [&](int32_t u) { vg[fill[u]++] = g; });
+    }
+    std::vector<int32_t> color(ng, -1), seen;
+    int32_t ncolors = 0;
+    for (int32_t g = 0; g < ng; ++g) {
+      for_free(g, [&](int32_t u) {
+        for (int32_t i = vg_start[u]; i < vg_start[u + 1]; ++i) {
+          const int32_t c = color[vg[i]];
+          if (c >= 0) {
+            if (c >= static_cast<int32_t>(seen.size())) seen.resize(c + 1, -1);
+            seen[c] = g;
+          }
+        }
+      });
+      int32_t c = 0;
+      while (c < static_cast<int32_t>(seen.size()) && seen[c] == g) ++c;
+      color[g] = c;
+      ncolors = std::max(ncolors, c + 1);
+    }
+    color_start.assign(ncolors + 1, 0);
+    for (int32_t g = 0; g < ng; ++g) ++color_start[color[g] + 1];
+    for (int32_t c = 0; c < ncolors; ++c) color_start[c + 1] += color_start[c];
+    color_groups.resize(ng);
+    std::vector<int32_t> fill(color_start.begin(), color_start.end() - 1);
+    for (int32_t g = 0; g < ng; ++g) color_groups[fill[color[g]]++] = g;
+    analyzed = false;
+  }
+
+  /// Fills the values with the projected Hessian of `kernel` at the current prob.pos.
+  void assemble(const Problem& prob, const WinslowKernel& kernel) {
+    double* val = h.valuePtr();
+    std::fill(val, val + h.nonZeros(), 0.0);
+    const int32_t ncolors = static_cast<int32_t>(color_start.size()) - 1;
+    for (int32_t col = 0; col < ncolors; ++col)
+      tbb::parallel_for(
+          tbb::blocked_range<int32_t>(color_start[col], color_start[col + 1], 16),
+          [&](const tbb::blocked_range<int32_t>& r) {
+            Mat9 hf;
+            Mat12 hc;
+            for (int32_t i = r.begin(); i != r.end(); ++i) {
+              const int32_t g = color_groups[i];
+              for (int32_t c = prob.group_start[g]; c < prob.group_start[g + 1]; ++c) {
+                const auto& k = prob.corners[c];
+                const Vec3& p0 = prob.pos[k[0]];
+                kernel.hessian(prob.pos[k[1]] - p0, prob.pos[k[2]] - p0, prob.pos[k[3]] - p0, hf, true);
+                untangle_detail::corner_hessian(hf, hc);
+                for (int p = 0; p < 10; ++p) {
+                  const auto& blk = corner_block[c][p];
+                  if (blk[0] < 0) continue;
+                  const int a = kPairs[p][0], b = kPairs[p][1];
+                  // Rows of the stored block come from point `ra`, columns from `cb`.
+                  const int ra = corner_swap[c][p] ? b : a, cb = corner_swap[c][p] ? a : b;
+                  for (int j = 0; j < 3; ++j)
+                    for (int i = 0; i < (a == b ? j + 1 : 3); ++i)
+                      val[blk[j] + i] += hc(3 * ra + i, 3 * cb + j);
+                }
+              }
+            }
+          });
+  }
+
+  /// Factorizes H + shift I; false when CHOLMOD finds it not positive definite.
+  bool factorize(double shift) {
+    if (shift != 0.0)
+      for (int32_t i : diag_index) h.valuePtr()[i] += shift;
+    auto run = [&](auto& solver) {
+      if (!analyzed) solver.analyzePattern(h);
+      analyzed = true;
+      solver.factorize(h);
+      return solver.info() == Eigen::Success;
+    };
+    const bool ok = use_supernodal ? run(supernodal) : run(simplicial);
+    if (shift != 0.0)
+      for (int32_t i : diag_index) h.valuePtr()[i] -= shift;
+    return ok;
+  }
+
+  Eigen::VectorXd solve(const Eigen::VectorXd& b) {
+    return use_supernodal ? Eigen::VectorXd(supernodal.solve(b)) : Eigen::VectorXd(simplicial.solve(b));
+  }
+};
+
+struct NewtonRun {
+  int iterations = 0, factorizations = 0;
+  double solve_time_s = 0.0;
+};
+
+/// Projected Newton on the phase 1 energy from x, at most `max_iterations` steps: solve
+/// (H + shift I) dx = -g, backtrack (Armijo) from the full step. The shift starts at a tiny
+/// fraction of the mean diagonal (the clamped Hessian can be singular) and grows by 100 when the
+/// factorization fails. Stops when a step gains less than rtol |E|, or no step is accepted.
+NewtonRun newton(Problem& prob, NewtonSystem& sys, const WinslowKernel& kernel, Eigen::VectorXd& x,
+                 const UntangleParams& p, int max_iterations) {
+  NewtonRun run;
+  const int64_t n = x.size();
+  Eigen::VectorXd g(n), gt(n), xt(n);
+  double f = prob.evaluate(x, g, kernel);
+  for (int it = 0; it < max_iterations; ++it) {
+    const auto t0 = Clock::now();
+    sys.assemble(prob, kernel);  // prob.pos holds x: evaluate() was last called at x
+    double mean_diag = 0.0;
+    for (int32_t i : sys.diag_index) mean_diag += sys.h.valuePtr()[i];
+    mean_diag = std::max(mean_diag / std::max<int64_t>(1, n), 1e-300);
+    double shift = 1e-10 * mean_diag;
+    bool ok = false;
+    for (int attempt = 0; attempt < 8 && !ok; ++attempt, shift *= 100.0) {
+      ok = sys.factorize(shift);
+      ++run.factorizations;
+    }
+    if (!ok) {
+      run.solve_time_s += seconds_since(t0);
+      break;
+    }
+    const Eigen::VectorXd dx = sys.solve(-g);
+    run.solve_time_s += seconds_since(t0);
+    const double slope = g.dot(dx);
+    if (!(slope < 0.0)) break;
+    double alpha = 1.0, ft = 0.0;
+    bool accepted = false;
+    for (int ls = 0; ls < 40; ++ls, alpha *= 0.5) {
+      xt = x + alpha * dx;
+      ft = prob.evaluate(xt, gt, kernel);
+      if (std::isfinite(ft) && ft <= f + 1e-4 * alpha * slope) {
+        accepted = true;
+        break;
+      }
+    }
+    if (!accepted) {
+      prob.evaluate(x, g, kernel);  // leave prob.pos at x
+      break;
+    }
+    ++run.iterations;
+    const double gain = f - ft;
+    x.swap(xt);
+    g.swap(gt);
+    f = ft;
+    if (gain <= p.newton_rtol * std::abs(f)) break;
+  }
+  return run;
 }
 
 struct HexQuality {
@@ -277,10 +459,12 @@ UntangleResult run_untangle(const HexMesh& mesh, const std::vector<uint8_t>& fix
       prob.free_point.push_back(v);
     }
   const int32_t nu = static_cast<int32_t>(prob.free_point.size());
+  res.stats.solver = params.solver;
   res.stats.free_vertices = nu;
 
-  // Active and forced corners.
-  for (const Hex& h : mesh.hexes)
+  // Active and forced corners; the active corners of one hex form a group (Newton assembly).
+  prob.group_start.push_back(0);
+  for (const Hex& h : mesh.hexes) {
     for (int c = 0; c < 8; ++c) {
       const std::array<int32_t, 4> k{h[c], h[kHexCornerFrames[c][0]], h[kHexCornerFrames[c][1]],
                                      h[kHexCornerFrames[c][2]]};
@@ -302,6 +486,9 @@ UntangleResult run_untangle(const HexMesh& mesh, const std::vector<uint8_t>& fix
         prob.corners.push_back(k);
       }
     }
+    if (static_cast<int32_t>(prob.corners.size()) > prob.group_start.back())
+      prob.group_start.push_back(static_cast<int32_t>(prob.corners.size()));
+  }
   const int32_t nc = prob.num_corners();
   res.stats.active_corners = nc;
   // Incidence CSR: for each unknown, the corner slots that use it, in corner order.
@@ -345,9 +532,18 @@ UntangleResult run_untangle(const HexMesh& mesh, const std::vector<uint8_t>& fix
     prob.evaluate(x, g, k);
     double detmin = prob.min_corner_value();
     k.eps = detmin > 0 ? 1e-10 : 1.0;
+    NewtonSystem sys;
+    if (params.solver == UntangleSolver::newton) sys.build(prob, params.supernodal);
     for (int round = 0; round < params.max_outer; ++round) {
       const double e_prev = prob.evaluate(x, g, k);
-      res.stats.untangle.iterations += minimize(prob, k, x, params, params.max_inner);
+      if (params.solver == UntangleSolver::newton) {
+        const NewtonRun nr = newton(prob, sys, k, x, params, params.max_newton);
+        res.stats.untangle.iterations += nr.iterations;
+        res.stats.untangle.factorizations += nr.factorizations;
+        res.stats.untangle.solve_time_s += nr.solve_time_s;
+      } else {
+        res.stats.untangle.iterations += minimize(prob, k, x, params, params.max_inner);
+      }
       const double e = prob.evaluate(x, g, k);
       detmin = prob.min_corner_value();
       ++res.stats.untangle.rounds;

@@ -1,4 +1,5 @@
 // Untangling, quality optimization, forced configurations and pillowing (src/geometry).
+#include "geometry/untangle_kernels.h"
 #include "hexpeel/embedding.h"
 #include "hexpeel/pillow.h"
 #include "hexpeel/pipeline.h"
@@ -10,6 +11,7 @@
 #include <tbb/global_control.h>
 
 #include <cstring>
+#include <random>
 
 namespace hexpeel {
 namespace {
@@ -33,9 +35,78 @@ HexComplex complex_of(const Generated& g) {
   return c;
 }
 
+TEST(GeometryUntangle, SolverNamesRoundTrip) {
+  for (UntangleSolver s : {UntangleSolver::newton, UntangleSolver::lbfgs}) {
+    UntangleSolver back = s == UntangleSolver::newton ? UntangleSolver::lbfgs : UntangleSolver::newton;
+    EXPECT_TRUE(parse_untangle_solver(to_string(s), back));
+    EXPECT_EQ(back, s);
+  }
+  UntangleSolver s = UntangleSolver::lbfgs;
+  EXPECT_FALSE(parse_untangle_solver("cg", s));
+  EXPECT_EQ(s, UntangleSolver::lbfgs);
+}
+
+// The Newton path's corner Hessian: the exact one matches finite differences of the analytic
+// gradient (upright, flat and inverted tetrahedra, large and tiny eps); the projected one is
+// positive semi-definite and equals the exact one where that already is.
+TEST(GeometryUntangle, WinslowHessianMatchesFiniteDifferences) {
+  std::mt19937_64 rng(42);
+  std::uniform_real_distribution<double> uni(-1.0, 1.0);
+  int convex_seen = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    SCOPED_TRACE("trial " + std::to_string(trial));
+    const double eps = trial % 3 == 0 ? 1.0 : (trial % 3 == 1 ? 0.05 : 1e-3);
+    untangle_detail::WinslowKernel k{eps, trial % 2 == 0 ? 1.0 : 0.3};
+    std::array<Vec3, 3> e;
+    for (int i = 0; i < 3; ++i) e[i] = Vec3::Unit(i) + 0.6 * Vec3(uni(rng), uni(rng), uni(rng));
+    if (trial % 4 == 1) e[2] = -e[2];               // inverted
+    if (trial % 4 == 2) e[2] = 0.5 * (e[0] + e[1]);  // flat
+    auto grad = [&](const std::array<Vec3, 3>& x) {
+      Eigen::Matrix<double, 9, 1> g;
+      Vec3 g0, g1, g2;
+      double det;
+      k(x[0], x[1], x[2], g0, g1, g2, det);
+      g << g0, g1, g2;
+      return g;
+    };
+    untangle_detail::Mat9 h, hp;
+    const double f = k.hessian(e[0], e[1], e[2], h, false);
+    k.hessian(e[0], e[1], e[2], hp, true);
+    Vec3 g0, g1, g2;
+    double det;
+    EXPECT_NEAR(f, k(e[0], e[1], e[2], g0, g1, g2, det), 1e-12 * std::abs(f));
+    untangle_detail::Mat9 fd;
+    const double step = 1e-5;  // fourth-order central differences (the energy is steep at eps -> 0)
+    for (int j = 0; j < 9; ++j) {
+      auto at = [&](double t) {
+        std::array<Vec3, 3> x = e;
+        x[j / 3](j % 3) += t;
+        return grad(x);
+      };
+      fd.col(j) = (8.0 * (at(step) - at(-step)) - (at(2 * step) - at(-2 * step))) / (12.0 * step);
+    }
+    EXPECT_LE((fd - h).norm(), 1e-4 * std::max(1.0, h.norm())) << "exact\n" << h << "\nfd\n" << fd;
+    EXPECT_LE((h - h.transpose()).norm(), 1e-10 * h.norm());
+    Eigen::SelfAdjointEigenSolver<untangle_detail::Mat9> exact(h), projected(hp);
+    EXPECT_GE(projected.eigenvalues().minCoeff(), -1e-9 * hp.norm());
+    if (exact.eigenvalues().minCoeff() > 1e-9 * h.norm()) {
+      ++convex_seen;
+      EXPECT_LE((hp - h).norm(), 1e-9 * h.norm());
+    }
+    // The 12x12 point Hessian: rows sum to zero (a translation changes nothing).
+    untangle_detail::Mat12 h12;
+    untangle_detail::corner_hessian(h, h12);
+    Eigen::Matrix<double, 12, 1> shift;
+    for (int a = 0; a < 4; ++a) shift.segment<3>(3 * a) = Vec3(0.3, -0.2, 0.7);
+    EXPECT_LE((h12 * shift).norm(), 1e-9 * h12.norm() + 1e-12);
+  }
+  EXPECT_GT(convex_seen, 0);
+}
+
 TEST(GeometryUntangle, JitteredGridBecomesPositiveAndBoundaryStays) {
-  for (uint64_t seed : {1u, 2u, 3u}) {
-    SCOPED_TRACE("seed " + std::to_string(seed));
+  for (uint64_t seed : {1u, 2u, 3u})
+  for (UntangleSolver solver : {UntangleSolver::newton, UntangleSolver::lbfgs}) {
+    SCOPED_TRACE("seed " + std::to_string(seed) + " solver " + std::string(to_string(solver)));
     // The whole interior scrambled far beyond its cells; the surface untouched.
     Generated g = testing::jittered(testing::cube(4, 4, 4, 0.25), seed, 0.0);
     for (int32_t v = g.surface.num_points(); v < g.known_mesh.num_points(); ++v)
@@ -43,7 +114,11 @@ TEST(GeometryUntangle, JitteredGridBecomesPositiveAndBoundaryStays) {
                                      0.2 * std::sin(7.0 * v * seed));
     QualityReport before = run_quality(g.known_mesh);
     ASSERT_GT(before.sj_count_nonpositive, 0) << "the scrambled start should be tangled";
-    UntangleResult r = run_untangle(g.known_mesh, surface_fixed(g));
+    UntangleParams p;
+    p.solver = solver;
+    UntangleResult r = run_untangle(g.known_mesh, surface_fixed(g), p);
+    EXPECT_EQ(r.stats.solver, solver);
+    if (solver == UntangleSolver::newton) EXPECT_GT(r.stats.untangle.factorizations, 0);
     ASSERT_TRUE(r.status.ok()) << to_string(r.status);
     for (int32_t v = 0; v < g.surface.num_points(); ++v)
       ASSERT_EQ(std::memcmp(r.mesh.points[v].data(), g.known_mesh.points[v].data(), sizeof(Vec3)), 0)
@@ -59,13 +134,21 @@ TEST(GeometryUntangle, JitteredGridBecomesPositiveAndBoundaryStays) {
 
 TEST(GeometryUntangle, SameBytesForAnyThreadCount) {
   Generated g = testing::jittered(testing::cubed_sphere_equiangular(5), 11, 0.3);
-  auto run = [&](int threads) {
-    tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
-    return run_untangle(g.known_mesh, surface_fixed(g)).mesh;
-  };
-  HexMesh a = run(1), b = run(2);
-  ASSERT_EQ(a.points.size(), b.points.size());
-  EXPECT_EQ(std::memcmp(a.points.data(), b.points.data(), a.points.size() * sizeof(Vec3)), 0);
+  for (UntangleSolver solver : {UntangleSolver::newton, UntangleSolver::lbfgs})
+  for (bool supernodal : {true, false}) {
+    if (solver == UntangleSolver::lbfgs && !supernodal) continue;
+    SCOPED_TRACE(std::string(to_string(solver)) + (supernodal ? " supernodal" : " simplicial"));
+    UntangleParams p;
+    p.solver = solver;
+    p.supernodal = supernodal;
+    auto run = [&](int threads) {
+      tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
+      return run_untangle(g.known_mesh, surface_fixed(g), p).mesh;
+    };
+    HexMesh a = run(1), b = run(2);
+    ASSERT_EQ(a.points.size(), b.points.size());
+    EXPECT_EQ(std::memcmp(a.points.data(), b.points.data(), a.points.size() * sizeof(Vec3)), 0);
+  }
 }
 
 TEST(GeometryUntangle, OptimizeNeverLowersTheMinimum) {
