@@ -5,7 +5,7 @@
 //                [--time-limit S] [--method original|kremer] [--no-zero-volume]
 //                [--no-enclosed] [--no-concave] [--no-false-positive] [--no-concave-waits]
 //                [--intrusion-fallback] [--pillow auto|all|none] [--no-untangle]
-//                [--no-optimize] [--quiet]
+//                [--no-optimize] [--solver lbfgs|newton] [--quiet]
 //   hexpeel quality MESH [--surface IN] [--json FILE]
 //
 // Exit codes: 0 success, 1 usage error, 2 bad input or file problem (for `quality`: also a mesh
@@ -242,13 +242,17 @@ int main(int argc, char** argv) {
   std::string planner = "search";
   mesh->add_option("--planner", planner,
                    "search: portfolio search over elimination orders (greedy, windowed backtracking, "
-                   "beam, restarts), never stuck where an order exists within the budget; "
+                   "conflict-directed restarts, beam, restarts) within the budget; "
                    "greedy: one greedy pass in the order rules' order (the paper's method)")
       ->check(CLI::IsMember({"search", "greedy"}))->capture_default_str();
   mesh->add_option("--plan-budget", params.planner.budget_s,
                    "wall-clock budget of the search (s); the search stops earlier when its "
                    "strategies are done. A run that hits the budget may depend on machine speed")
       ->check(CLI::PositiveNumber)->capture_default_str();
+  mesh->add_option("--improve-budget", params.planner.improve_budget_s,
+                   "seconds (within --plan-budget) spent looking for a cheaper plan when the first "
+                   "one needed backtracking; 0 = keep the first plan")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
   mesh->add_option("--seed", params.planner.seed, "seed of the search's randomized restarts")
       ->capture_default_str();
   std::string side_rule = "cost";
@@ -287,6 +291,11 @@ int main(int argc, char** argv) {
                  "keep the harmonic placement: no Winslow untangling (default: untangle)");
   mesh->add_flag("--no-optimize", no_optimize,
                  "skip the scaled-Jacobian optimization after untangling (default: optimize)");
+  std::string solver = "lbfgs";
+  mesh->add_option("--solver", solver,
+                   "untangling minimizer: lbfgs (L-BFGS) or newton (projected Newton with a "
+                   "CHOLMOD sparse Cholesky; fewer, much costlier iterations) (default: lbfgs)")
+      ->check(CLI::IsMember({"lbfgs", "newton"}))->capture_default_str();
   mesh->add_flag("-q,--quiet", quiet, "print only warnings and errors");
 
   auto* quality = app.add_subcommand("quality", "Report the quality of any hex mesh (.vtk .vtu .mesh .msh).");
@@ -313,6 +322,7 @@ int main(int argc, char** argv) {
                                               : PillowMode::automatic;
       params.untangle.untangle = !no_untangle;
       params.untangle.optimize = !no_optimize;
+      parse_untangle_solver(solver, params.untangle.solver);
       OrderParams& order = params.elimination.order;
       order.method = method == "original" ? Method::original : Method::kremer;
       order.zero_volume = !no_zero_volume;

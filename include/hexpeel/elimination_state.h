@@ -112,12 +112,20 @@ class EliminationState {
   /// Quads on side s of chord c (sorted ids), by a search that never enters the chord.
   void side_region(int32_t c, int side, std::vector<int32_t>& out) const;
 
+  /// Which side of chord c every chord lies on: out[d] = 0 (left) or 1 (right) for an alive chord
+  /// d != c that does not cross c (it then lies wholly on one side), -1 otherwise. Floods only
+  /// the smaller side when the two sides partition the rest of the surface. O(min side + chords).
+  void chord_sides(int32_t c, std::vector<int8_t>& out) const;
+
   /// Number of quads on side s of chord c. The first call after a change computes all chords'
   /// sizes at once by spanning-tree flux (O(quads + chord lengths)); later calls are O(1).
   int32_t side_size(int32_t c, int side) const;
 
   /// Collapses chord c, recording the step for side s (which must be usable). O(|c| + |side|).
   PlanStep apply(int32_t c, int side);
+  /// Collapses chord c without recording a step (the surface does not depend on the side; search
+  /// uses this and records only the plan it keeps). O(|c|).
+  void collapse(int32_t c);
   /// Undoes the last apply. O(|c|).
   void undo();
 
@@ -127,6 +135,7 @@ class EliminationState {
 
  private:
   int32_t find(int32_t v) const;
+  int32_t valence(int32_t q, int corner) const;
   bool side_usable(const std::vector<ChordStep>& steps, int side) const;
   Infeasible collapse_test(const std::vector<ChordStep>& steps) const;
   void compute_side_sizes() const;
@@ -165,6 +174,17 @@ class EliminationState {
   mutable std::vector<int32_t> qstamp_;           ///< collapse_test: quad seen marks
   mutable int32_t vepoch_ = 0, repoch_ = 0, qepoch_ = 0;
   mutable std::vector<int32_t> chord_hits_;    ///< collapse_test: crossings per other chord
+  /// collapse_test's working lists, kept between calls to avoid allocations.
+  struct CollapseScratch {
+    std::vector<int32_t> touched, vc, faces_a, vc_faces_all, rset, rlive, around, at, par;
+    std::vector<std::pair<int32_t, int>> vc_corner, x_corner;
+    std::vector<Quad> newf;
+    std::vector<std::pair<uint64_t, int32_t>> ekeys;
+    std::vector<std::pair<int32_t, int32_t>> nbr, links, faces_at;
+    std::vector<std::pair<int32_t, std::pair<int32_t, int>>> xs;
+    std::vector<uint64_t> old_edges;
+  };
+  mutable CollapseScratch cs_;
   mutable std::vector<ChordStep> scratch_steps_;
   mutable bool sizes_valid_ = false;                     ///< side_sizes_ match the surface
   mutable std::vector<std::array<int32_t, 2>> side_sizes_;  ///< per chord, [left, right]

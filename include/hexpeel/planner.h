@@ -6,8 +6,10 @@
 // what is feasible later. The portfolio, within a time budget:
 //   1. cost-guided greedy in the OrderPolicy's order; when stuck, a complete depth-first search
 //      over the last k steps (k = 1..window) with dead states remembered;
-//   2. beam search over partial plans scored by cost;
-//   3. randomized restarts (noisy priorities) of 1.
+//   2. when that found no plan: conflict-directed search (chords left at stuck states gain
+//      priority; restarts with small repair windows and fresh noise per round);
+//   3. when the plan needed backtracking: beam search over partial plans scored by cost, and
+//   4. randomized restarts (noisy priorities) of 1, looking for a cheaper plan.
 // The best complete plan by cost is kept and replayed on the state.
 #pragma once
 
@@ -24,17 +26,23 @@ namespace hexpeel {
 struct PlannerParams {
   OrderParams order;            ///< priorities and side rule (run_mesh passes its own, with
                                 ///< SideRule::cost, the planner's default)
-  double budget_s = 10.0;       ///< wall-clock budget of the whole search (s, > 0)
+  double budget_s = 30.0;       ///< wall-clock budget of the whole search (s, > 0)
+  /// Time for looking for a cheaper plan once one was found by backtracking (beam + restarts),
+  /// within budget_s (s, >= 0).
+  double improve_budget_s = 10.0;
   uint64_t seed = 1;            ///< seed of the randomized restarts
   double flat_penalty = 0.0;    ///< cost per flat step, in hexes; 0 = the quad count of the input
   int window = 12;              ///< deepest backtrack of the windowed search (steps)
   int64_t window_nodes = 20000; ///< node budget of one windowed search
   int beam_width = 8;           ///< states kept per beam level
   int beam_moves = 4;           ///< moves expanded per state
+  int conflict_window = 12;     ///< conflict search: deepest repair backtrack per round (steps)
+  int64_t conflict_window_nodes = 20;   ///< conflict search: node budget per repair window
+  double conflict_bump = 0.05;  ///< conflict search: first activity bump (weight units)
+  double conflict_growth = 1.1; ///< conflict search: bump growth per round (> 1 = recent first)
   int restarts = 8;             ///< randomized restarts after the beam
   double noise = 0.3;           ///< priority noise of restarts (in weight units)
-  /// When the first plan needed backtracking, run beam and restarts for a cheaper one too (they
-  /// always run when greedy with backtracking found no plan).
+  /// When the first plan needed backtracking, run beam and restarts for a cheaper one too.
   bool improve = true;
 };
 
@@ -44,8 +52,9 @@ struct PlannerStats {
   int64_t backtracks = 0;         ///< steps undone
   int64_t states_remembered = 0;  ///< dead states in the memo
   int64_t stuck_events = 0;       ///< greedy descents that got stuck
+  int64_t conflict_rounds = 0;    ///< conflict-directed restarts that got stuck
   double best_cost = 0.0;         ///< cost of the chosen plan
-  std::string strategy;           ///< which strategy found it: greedy, window, beam, restart
+  std::string strategy;           ///< which strategy found it: greedy, window, conflict, beam, restart
   double time_s = 0.0;
   bool budget_exhausted = false;
 };

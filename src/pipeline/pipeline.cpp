@@ -170,6 +170,7 @@ nlohmann::json to_json(const MeshResult& r) {
                     {"backtracks", r.planner.backtracks},
                     {"states_remembered", r.planner.states_remembered},
                     {"stuck_events", r.planner.stuck_events},
+                    {"conflict_rounds", r.planner.conflict_rounds},
                     {"best_cost", r.planner.best_cost},
                     {"strategy", r.planner.strategy},
                     {"budget_exhausted", r.planner.budget_exhausted},
@@ -217,7 +218,7 @@ nlohmann::json to_json(const MeshResult& r) {
                             {"nonpositive_before", s.nonpositive_before},
                             {"nonpositive_after", s.nonpositive_after}};
     };
-    j["untangle"] = {{"method", "lbfgs"},
+    j["untangle"] = {{"method", std::string(to_string(u.solver))},
                      {"free_vertices", u.free_vertices},
                      {"active_corners", u.active_corners},
                      {"forced_corners", u.forced_corners},

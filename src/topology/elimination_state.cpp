@@ -11,7 +11,6 @@
 #include "hexpeel/elimination_state.h"
 
 #include <algorithm>
-#include <functional>
 #include <numeric>
 #include <utility>
 
@@ -257,7 +256,8 @@ bool EliminationState::side_usable(const std::vector<ChordStep>& steps, int side
 
 Infeasible EliminationState::collapse_test(const std::vector<ChordStep>& steps) const {
   // Chord quads are marked by the caller. Trial merges live in local_parent_ (reset at the end).
-  std::vector<int32_t> touched;
+  auto& touched = cs_.touched;
+  touched.clear();
   auto lfind = [&](int32_t v) {
     int32_t r = find(v);
     while (local_parent_[r] >= 0) r = local_parent_[r];
@@ -278,8 +278,10 @@ Infeasible EliminationState::collapse_test(const std::vector<ChordStep>& steps) 
   // VC: current vertices of the chord quads (one (quad, corner) kept per vertex); rotate around
   // each to find the quads touching them. Stamps replace sorting for the deduplication.
   const int32_t vep = next_epoch(vepoch_, vstamp_);
-  std::vector<int32_t> vc;
-  std::vector<std::pair<int32_t, int>> vc_corner;
+  auto& vc = cs_.vc;
+  auto& vc_corner = cs_.vc_corner;
+  vc.clear();
+  vc_corner.clear();
   for (const ChordStep& s : steps)
     for (int k = 0; k < 4; ++k) {
       int32_t v = find(surface_->quads[s.quad][k]);
@@ -303,8 +305,10 @@ Infeasible EliminationState::collapse_test(const std::vector<ChordStep>& steps) 
     } while (q != q0 || k != k0);
   };
   const int32_t qep = next_epoch(qepoch_, qstamp_);
-  std::vector<int32_t> faces_a;       // non-chord quads touching VC
-  std::vector<int32_t> vc_faces_all;  // chord + non-chord quads touching VC (for the Euler count)
+  auto& faces_a = cs_.faces_a;            // non-chord quads touching VC
+  auto& vc_faces_all = cs_.vc_faces_all;  // chord + non-chord quads touching VC (Euler count)
+  faces_a.clear();
+  vc_faces_all.clear();
   for (auto& qc : vc_corner)
     rotate(qc.first, qc.second, [&](int32_t q, int) {
       if (qstamp_[q] == qep) return;
@@ -314,7 +318,8 @@ Infeasible EliminationState::collapse_test(const std::vector<ChordStep>& steps) 
     });
 
   // New corners of the touching quads.
-  std::vector<Quad> newf(faces_a.size());
+  auto& newf = cs_.newf;
+  newf.resize(faces_a.size());
   for (size_t i = 0; i < faces_a.size(); ++i) {
     const Quad& f = surface_->quads[faces_a[i]];
     for (int k = 0; k < 4; ++k) newf[i][k] = lfind(f[k]);
@@ -323,15 +328,18 @@ Infeasible EliminationState::collapse_test(const std::vector<ChordStep>& steps) 
         if (newf[i][a] == newf[i][b]) return reset(), Infeasible::degenerate_face;
   }
   // R: merged vertices (images of VC).
-  std::vector<int32_t> rset;
+  auto& rset = cs_.rset;
+  rset.clear();
   for (int32_t v : vc) rset.push_back(lfind(v));
   const int32_t rep = next_epoch(repoch_, rstamp_);
   for (int32_t v : rset) rstamp_[v] = rep;
   auto in_r = [&](int32_t v) { return rstamp_[v] == rep; };
 
   // Edges touching R: (key, face index) pairs; every key must appear exactly twice.
-  std::vector<std::pair<uint64_t, int32_t>> ekeys;
-  std::vector<std::pair<int32_t, int32_t>> nbr;  // (r, neighbour)
+  auto& ekeys = cs_.ekeys;
+  auto& nbr = cs_.nbr;  // (r, neighbour)
+  ekeys.clear();
+  nbr.clear();
   for (size_t i = 0; i < newf.size(); ++i)
     for (int k = 0; k < 4; ++k) {
       int32_t a = newf[i][k], b = newf[i][(k + 1) & 3];
@@ -349,7 +357,8 @@ Infeasible EliminationState::collapse_test(const std::vector<ChordStep>& steps) 
   }
   std::sort(nbr.begin(), nbr.end());
   nbr.erase(std::unique(nbr.begin(), nbr.end()), nbr.end());
-  std::vector<int32_t> rlive;
+  auto& rlive = cs_.rlive;
+  rlive.clear();
   for (size_t i = 0; i < nbr.size();) {
     size_t j = i;
     while (j < nbr.size() && nbr[j].first == nbr[i].first) ++j;
@@ -358,19 +367,21 @@ Infeasible EliminationState::collapse_test(const std::vector<ChordStep>& steps) 
     i = j;
   }
   // Unmerged neighbours of merged vertices may lose an edge (two of their edges merge).
-  std::vector<std::pair<int32_t, int>> x_corner;
+  auto& x_corner = cs_.x_corner;
+  x_corner.clear();
   for (size_t i = 0; i < newf.size(); ++i)
     for (int k = 0; k < 4; ++k)
       if (!in_r(newf[i][k]) && (in_r(newf[i][(k + 1) & 3]) || in_r(newf[i][(k + 3) & 3])))
         x_corner.push_back({faces_a[i], k});
   {
-    std::vector<std::pair<int32_t, std::pair<int32_t, int>>> tmp;
+    auto& tmp = cs_.xs;
+    tmp.clear();
     for (auto& qc : x_corner) tmp.push_back({find(surface_->quads[qc.first][qc.second]), qc});
     std::sort(tmp.begin(), tmp.end());
     tmp.erase(std::unique(tmp.begin(), tmp.end(),
                           [](auto& x, auto& y) { return x.first == y.first; }),
               tmp.end());
-    std::vector<int32_t> around;
+    auto& around = cs_.around;
     for (auto& t : tmp) {
       around.clear();
       rotate(t.second.first, t.second.second, [&](int32_t q, int k) {
@@ -385,10 +396,11 @@ Infeasible EliminationState::collapse_test(const std::vector<ChordStep>& steps) 
   }
   // Quads around each merged vertex: pairs sharing >= 2 vertices must share exactly an edge;
   // and the quads must form one fan (connected through edges at that vertex).
-  std::vector<int32_t> at;
-  std::vector<std::pair<int32_t, int32_t>> links;
+  auto& at = cs_.at;
+  auto& links = cs_.links;
   // (merged vertex, face index) pairs, grouped by vertex
-  std::vector<std::pair<int32_t, int32_t>> faces_at;
+  auto& faces_at = cs_.faces_at;
+  faces_at.clear();
   for (size_t i = 0; i < newf.size(); ++i)
     for (int k = 0; k < 4; ++k)
       if (in_r(newf[i][k])) faces_at.push_back({newf[i][k], static_cast<int32_t>(i)});
@@ -423,12 +435,16 @@ Infeasible EliminationState::collapse_test(const std::vector<ChordStep>& steps) 
     }
     std::sort(links.begin(), links.end());
     // union-find over `at` positions
-    std::vector<int32_t> par(at.size());
+    auto& par = cs_.par;
+    par.resize(at.size());
     std::iota(par.begin(), par.end(), 0);
     auto pos = [&](int32_t face) {
       return static_cast<int32_t>(std::lower_bound(at.begin(), at.end(), face) - at.begin());
     };
-    std::function<int32_t(int32_t)> pf = [&](int32_t x) { return par[x] == x ? x : par[x] = pf(par[x]); };
+    auto pf = [&](int32_t x) {
+      while (par[x] != x) x = par[x] = par[par[x]];
+      return x;
+    };
     int comps = static_cast<int>(at.size());
     for (size_t i = 0; i + 1 < links.size(); ++i)
       if (links[i].first == links[i + 1].first) {
@@ -438,7 +454,8 @@ Infeasible EliminationState::collapse_test(const std::vector<ChordStep>& steps) 
     if (comps != 1) return reset(), Infeasible::pinched_vertex;
   }
   // Euler characteristic: removed vertices - removed edges + removed faces must balance.
-  std::vector<uint64_t> old_edges;
+  auto& old_edges = cs_.old_edges;
+  old_edges.clear();
   for (int32_t q : vc_faces_all) {
     const Quad& f = surface_->quads[q];
     for (int k = 0; k < 4; ++k) {
@@ -455,6 +472,19 @@ Infeasible EliminationState::collapse_test(const std::vector<ChordStep>& steps) 
   reset();
   if (de - dv - df != 0) return Infeasible::euler;
   return Infeasible::none;
+}
+
+int32_t EliminationState::valence(int32_t q, int k) const {
+  // quads around the vertex at corner k of q (= its edges: the surface is a closed manifold)
+  int32_t n = 0, g = q;
+  int kk = k & 3;
+  do {
+    ++n;
+    const int32_t he = opp_[he_of(g, kk + 3)];
+    g = he >> 2;
+    kk = he & 3;
+  } while (g != q || kk != (k & 3));
+  return n;
 }
 
 EliminationState::Feasibility EliminationState::feasibility(int32_t c) const {
@@ -487,6 +517,14 @@ EliminationState::Feasibility EliminationState::feasibility(int32_t c) const {
     f.why = Infeasible::no_connected_side;
     return f;
   }
+  // Cheap exact shortcut for the commonest failure: a crossed edge whose two ends both have
+  // valence 3 lies between the two chord quads and one more quad at each end, so its merged
+  // vertex would keep at most two edges.
+  for (const ChordStep& s : steps)
+    if (valence(s.quad, s.edge) == 3 && valence(s.quad, s.edge + 1) == 3) {
+      f.why = Infeasible::low_valence;
+      return f;
+    }
   f.why = collapse_test(steps);
   return f;
 }
@@ -513,15 +551,49 @@ PlanStep EliminationState::apply(int32_t c, int side) {
   step.chord = c;
   step.side = static_cast<int8_t>(side);
   side_region(c, side, step.side_quads);
-  std::vector<ChordStep> steps;
-  chord_steps(c, steps);
-  mark_chord_quads(steps);
-  for (const ChordStep& s : steps) {
+  chord_steps(c, scratch_steps_);
+  mark_chord_quads(scratch_steps_);
+  for (const ChordStep& s : scratch_steps_) {
     int8_t es = static_cast<int8_t>((s.edge + (side == 0 ? 3 : 1)) & 3);
     int32_t he = opp_[he_of(s.quad, es)];
     HEXPEEL_ASSERT_MSG(!is_marked(he >> 2), "side-s neighbour of a chord quad is a chord quad");
     step.chord_quads.push_back({s.quad, es, he >> 2, static_cast<int8_t>(he & 3)});
   }
+  collapse(c);
+  return step;
+}
+
+void EliminationState::chord_sides(int32_t c, std::vector<int8_t>& out) const {
+  out.assign(chords_->chords.size(), -1);
+  const std::array<int32_t, 2> size{side_size(c, 0), side_size(c, 1)};
+  const int small = size[1] < size[0] ? 1 : 0;
+  // The sides partition the rest of the surface unless the chord touches itself so that a region
+  // borders both sides; then both are flooded.
+  const bool partition = size[0] + size[1] + chord_len_[c] == alive_quads_;
+  std::vector<int32_t> region, other;
+  if (!partition) side_region(c, 1 - small, other);  // sorted
+  side_region(c, small, region);  // stamps the region with epoch_, marks c's quads
+  std::vector<uint8_t> crossing(chords_->chords.size(), 0);
+  for (const ChordStep& s : chords_->chords[c].steps)
+    if (quad_alive_[s.quad]) crossing[chords_->chord_of[2 * s.quad + ((s.edge + 1) & 1)]] = 1;
+  for (size_t d = 0; d < chords_->chords.size(); ++d) {
+    if (static_cast<int32_t>(d) == c || chord_len_[d] == 0 || crossing[d]) continue;
+    int32_t q = -1;
+    for (const ChordStep& s : chords_->chords[d].steps)
+      if (quad_alive_[s.quad]) {
+        q = s.quad;
+        break;
+      }
+    if (stamp_[q] == epoch_) out[d] = static_cast<int8_t>(small);
+    else if (partition || std::binary_search(other.begin(), other.end(), q))
+      out[d] = static_cast<int8_t>(1 - small);
+  }
+}
+
+void EliminationState::collapse(int32_t c) {
+  std::vector<ChordStep> steps;
+  chord_steps(c, steps);
+  mark_chord_quads(steps);
 
   marks_.push_back(log_.size());
   sizes_valid_ = false;
@@ -578,7 +650,6 @@ PlanStep EliminationState::apply(int32_t c, int side) {
   chord_len_[c] = 0;
   alive_quads_ -= static_cast<int32_t>(steps.size());
   alive_chords_ -= 1;
-  return step;
 }
 
 void EliminationState::undo() {

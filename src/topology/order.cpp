@@ -33,6 +33,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
+#include <vector>
 
 namespace hexpeel {
 
@@ -65,46 +67,36 @@ bool has_zero_volume(const EliminationState& state, int32_t c, double tolerance_
   return any && state.chord_length(c) > 1 && std::abs(prev + first + 180.0) <= tolerance_deg;
 }
 
-/// What a side region holds: whole chords (any / non-flat) and whether it is flat inside.
-struct RegionFacts {
-  int32_t size = 0;
-  bool encloses_chord = false;     ///< some alive chord other than c lies entirely inside
-  bool encloses_nonflat = false;   ///< ... and crosses a sharp edge
-  bool flat_inside = true;         ///< no sharp edge between two quads of the region
+/// Whole alive chords enclosed on each side of chord c (any / crossing a sharp edge).
+struct Enclosed {
+  std::array<bool, 2> chord{};    ///< some alive chord other than c lies entirely on that side
+  std::array<bool, 2> nonflat{};  ///< ... and crosses a sharp edge
 };
 
-RegionFacts region_facts(const EliminationState& state, int32_t c, int side) {
+Enclosed enclosed_chords(const EliminationState& state, int32_t c) {
+  thread_local std::vector<int8_t> where;
+  state.chord_sides(c, where);
+  Enclosed e;
+  for (int32_t d = 0; d < static_cast<int32_t>(where.size()); ++d) {
+    if (where[d] < 0) continue;
+    e.chord[where[d]] = true;
+    if (!e.nonflat[where[d]] && state.weights(d).crossing_sharp > 0) e.nonflat[where[d]] = true;
+  }
+  return e;
+}
+
+/// 5.4 false positives: no sharp edge between two quads of side s of chord c.
+bool flat_inside(const EliminationState& state, int32_t c, int side) {
   std::vector<int32_t> region;
   state.side_region(c, side, region);
-  RegionFacts f;
-  f.size = static_cast<int32_t>(region.size());
-  auto inside = [&](int32_t q) { return std::binary_search(region.begin(), region.end(), q); };
-  // Passages of each chord inside the region; a chord is enclosed when all its passages are.
-  const ChordSet& cs = state.chord_set();
-  std::vector<std::pair<int32_t, int32_t>> hits;  // (chord, count), sorted by chord
-  std::vector<int32_t> through;
-  through.reserve(2 * region.size());
-  for (int32_t q : region) {
-    through.push_back(cs.chord_of[2 * q]);
-    through.push_back(cs.chord_of[2 * q + 1]);
-    if (f.flat_inside)
-      for (int k = 0; k < 4; ++k) {
-        const int32_t he = 4 * q + k;
-        if (state.edge_weight(he).sharp > 0 && inside(state.opposite(he) >> 2)) f.flat_inside = false;
-      }
-  }
-  std::sort(through.begin(), through.end());
-  for (size_t i = 0; i < through.size();) {
-    size_t j = i;
-    while (j < through.size() && through[j] == through[i]) ++j;
-    const int32_t d = through[i];
-    if (d != c && state.chord_alive(d) && static_cast<int32_t>(j - i) == state.chord_length(d)) {
-      f.encloses_chord = true;
-      if (state.weights(d).crossing_sharp > 0) f.encloses_nonflat = true;
+  for (int32_t q : region)
+    for (int k = 0; k < 4; ++k) {
+      const int32_t he = 4 * q + k;
+      if (state.edge_weight(he).sharp > 0 &&
+          std::binary_search(region.begin(), region.end(), state.opposite(he) >> 2))
+        return false;
     }
-    i = j;
-  }
-  return f;
+  return true;
 }
 
 /// The original side rule among `sides`: heavier sharp weight; ties -> fewer quads, then left.
@@ -209,11 +201,10 @@ Move OrderPolicy::full(const EliminationState& state, int32_t chord, std::array<
     return m;
   }
 
-  std::array<RegionFacts, 2> facts{};
-  std::array<bool, 2> known{};
-  auto facts_of = [&](int s) -> const RegionFacts& {
-    if (!known[s]) facts[s] = region_facts(state, chord, s), known[s] = true;
-    return facts[s];
+  std::optional<Enclosed> enc;
+  auto enclosed_of = [&]() -> const Enclosed& {
+    if (!enc) enc = enclosed_chords(state, chord);
+    return *enc;
   };
   bool concave_waits = false;
   if (params_.concave && !m.flat) {
@@ -222,9 +213,8 @@ Move OrderPolicy::full(const EliminationState& state, int32_t chord, std::array<
     if (w.concave[1] > w.concave[0]) std::swap(order[0], order[1]);
     for (int s : order) {
       if (!sides[s] || w.concave[s] <= 0 || w.concave[s] < params_.concave_min) continue;
-      const RegionFacts& f = facts_of(s);
-      if (params_.false_positive && !f.flat_inside) continue;
-      if (params_.concave_waits_for_enclosed && f.encloses_nonflat) {
+      if (params_.false_positive && !flat_inside(state, chord, s)) continue;
+      if (params_.concave_waits_for_enclosed && enclosed_of().nonflat[s]) {
         concave_waits = true;
         continue;
       }
@@ -239,12 +229,12 @@ Move OrderPolicy::full(const EliminationState& state, int32_t chord, std::array<
   std::array<bool, 2> pick = sides;
   if (params_.enclosed) {
     std::array<bool, 2> open{};
-    for (int s = 0; s < 2; ++s) open[s] = sides[s] && !facts_of(s).encloses_chord;
+    for (int s = 0; s < 2; ++s) open[s] = sides[s] && !enclosed_of().chord[s];
     if (open[0] || open[1]) pick = open;
     else m.waits = true;
   }
   if (concave_waits) m.waits = true;
-  const std::array<int32_t, 2> sizes{known[0] ? facts[0].size : -1, known[1] ? facts[1].size : -1};
+  const std::array<int32_t, 2> sizes{-1, -1};
   int side;
   double weight_key;
   if (params_.side_rule == SideRule::cost) {

@@ -71,6 +71,7 @@ struct Search {
   std::vector<Step> best;
   double best_cost = std::numeric_limits<double>::infinity();
   std::vector<Step> deepest_stuck;
+  std::vector<double> activity;  ///< conflict activity per chord (empty outside conflict search)
   bool aborted = false;       ///< the current phase (or the whole budget) ran out
   double phase_end_s = 0.0;   ///< end of the current phase, seconds from start
 
@@ -106,7 +107,7 @@ struct Search {
   }
 
   void push(const Step& s) {
-    st.apply(s.chord, s.side);
+    st.collapse(s.chord);
     path.push_back(s);
     hash ^= zob[s.chord];
     cost += step_cost(s);
@@ -133,13 +134,14 @@ struct Search {
     if (path.size() > deepest_stuck.size()) deepest_stuck = path;
   }
 
-  /// Noise added to a chord's priority weight (same value for its quick and full keys).
+  /// Shift of a chord's priority weight (same value for its quick and full keys): minus its
+  /// conflict activity, plus seeded noise.
   double noise_of(int32_t chord, uint64_t noise_seed) const {
-    if (noise_seed == 0) return 0.0;
+    const double shift = activity.empty() ? 0.0 : -activity[chord];
+    if (noise_seed == 0) return shift;
     uint64_t x = noise_seed * 0x100000001b3ull ^ (hash + static_cast<uint64_t>(chord) * 0x9e3779b97f4a7c15ull);
-    return params.noise * unit(splitmix(x));
+    return shift + params.noise * unit(splitmix(x));
   }
-
   /// Feasible moves of the current state, best first, rated lazily: quick keys order the
   /// chords, feasibility and the full rating are computed only for chords that reach the front.
   /// Valid while the state is the one it was made on (apply + undo in between is fine).
@@ -251,6 +253,43 @@ struct Search {
     while (!path.empty()) pop();
   }
 
+  /// Conflict-directed search, after the restarts of SAT solvers: a stuck descent adds activity
+  /// to the chords still alive at the stuck state (they are what could not be eliminated), which
+  /// raises their priority within their tier so that later descents eliminate them while they
+  /// still can be. Each round first repairs the stuck state by a small windowed search, then
+  /// restarts from the top with fresh priority noise. (Backjumping only part of the way was
+  /// measured on pierrot and found nothing in the same time: the chords that must go early are
+  /// decided far above the stuck state.) Leaves the path applied on success.
+  bool conflict_search() {
+    activity.assign(st.num_chords(), 0.0);
+    const size_t base = path.size();
+    double bump = params.conflict_bump;
+    uint64_t seeder = params.seed ^ 0xc0ff1c7ull;
+    for (int64_t round = 0; !out_of_time(); ++round) {
+      const uint64_t noise_seed = round == 0 ? 0 : splitmix(seeder) | 1;
+      if (greedy(noise_seed)) {
+        record_plan("conflict");
+        return true;
+      }
+      const size_t stuck_depth = path.size();
+      for (int32_t c = 0; c < st.num_chords(); ++c)
+        if (st.chord_alive(c)) activity[c] += bump;
+      bump *= params.conflict_growth;
+      for (int k = 1; k <= params.conflict_window && !aborted; ++k) {
+        if (stuck_depth < base + static_cast<size_t>(k)) break;
+        while (path.size() > stuck_depth - k) pop();
+        int64_t nodes = params.conflict_window_nodes;
+        if (dfs(nodes, noise_seed) == Outcome::success) {
+          record_plan("conflict");
+          return true;
+        }
+      }
+      while (path.size() > base) pop();
+      ++stats.conflict_rounds;
+    }
+    return false;
+  }
+
   /// Beam search over partial plans scored by cost, on copies of the state.
   void beam() {
     struct Node {
@@ -311,7 +350,7 @@ struct Search {
       std::vector<Node> next;
       for (const Cand& c : top) {
         Node n{level[c.parent].state, level[c.parent].steps, c.hash, c.score};
-        n.state.apply(c.step.chord, c.step.side);
+        n.state.collapse(c.step.chord);
         n.steps.push_back(c.step);
         ++stats.nodes;
         next.push_back(std::move(n));
@@ -324,7 +363,8 @@ struct Search {
 
 }  // namespace
 
-PlannerResult run_planner(EliminationState& state, const PlannerParams& params, const Context& ctx) {
+PlannerResult run_planner(EliminationState& state, const PlannerParams& params_in, const Context& ctx) {
+  PlannerParams params = params_in;
   PlannerResult res;
   EliminationPlan& plan = res.plan;
   for (int32_t c = 0; c < state.num_chords(); ++c)
@@ -336,22 +376,25 @@ PlannerResult run_planner(EliminationState& state, const PlannerParams& params, 
       return res;
     }
   Search s(state, params, ctx);
-  // 1. cost-guided greedy with windowed backtracking (at most 40% of the budget)
-  s.begin_phase(0.4);
+  // 1. cost-guided greedy with windowed backtracking (at most 15% of the budget)
+  s.begin_phase(0.15);
   if (s.greedy_with_window(0, "window")) s.unwind();
-  // Beam and restarts look for a plan when greedy found none, and for a cheaper one when the
-  // greedy plan needed rescuing (its tail came from backtracking, not from the priorities).
-  if (s.best.empty() || (params.improve && s.stats.stuck_events > 0)) {
-    // 2. beam search (at most 20% of the budget)
-    if (s.begin_phase(0.2)) s.beam();
-    // 3. randomized restarts, sharing what is left
+  // 2. no plan yet: conflict-directed search, with all the budget left
+  if (s.best.empty() && s.begin_phase(1.0) && s.conflict_search()) s.unwind();
+  // 3-4. A plan that needed rescuing (its tail came from backtracking, not from the priorities):
+  // beam search and randomized restarts look for a cheaper one, within improve_budget_s.
+  if (!s.best.empty() && params.improve && s.stats.stuck_events > 0) {
+    const double improve_end = std::min(params.budget_s, s.elapsed() + params.improve_budget_s);
+    auto begin = [&](double seconds) {
+      seconds = std::min(seconds, improve_end - s.elapsed());
+      return seconds > 0 && s.begin_phase(seconds / params.budget_s);
+    };
+    if (begin(0.3 * params.improve_budget_s)) s.beam();
     uint64_t seeder = params.seed;
     for (int r = 0; r < params.restarts; ++r) {
-      const double left = params.budget_s - s.elapsed();
-      if (left <= 0 || !s.begin_phase(left / (params.restarts - r) / params.budget_s)) break;
+      if (!begin((improve_end - s.elapsed()) / (params.restarts - r))) break;
       uint64_t noise_seed = splitmix(seeder) | 1;
       if (s.greedy_with_window(noise_seed, "restart")) s.unwind();
-      if (!params.improve && !s.best.empty()) break;
     }
   }
   s.unwind();

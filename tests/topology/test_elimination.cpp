@@ -149,6 +149,11 @@ TEST(Elimination, LocalTestAgreesWithBruteForce3Connectivity) {
                           << " chord " << c << ": local " << local << " brute " << brute;
           }
           auto f = st.feasibility(c);
+          // feasibility() adds side checks and shortcuts (low valence) to the local test: a
+          // feasible verdict must be polyhedral, a low-valence verdict must not be
+          if (f.ok() && !brute) ++disagreements, ADD_FAILURE() << g.name << " chord " << c << ": feasible, not polyhedral";
+          if (f.why == Infeasible::low_valence && brute)
+            ++disagreements, ADD_FAILURE() << g.name << " chord " << c << ": low valence, but polyhedral";
           if (f.ok())
             for (int s = 0; s < 2; ++s)
               if (f.sides[s]) moves.push_back({c, s});
