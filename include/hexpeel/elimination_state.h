@@ -143,6 +143,7 @@ class EliminationState {
   bool is_marked(int32_t q) const { return cmark_[q] == cepoch_; }
   void set_opp(int32_t he, int32_t value);
   void set_weight(int32_t he, const EdgeWeight& w);
+  void touch_quad(int32_t q);  ///< invalidates the cached weights of the chords through q
 
   const QuadSurface* surface_;  ///< the input surface (outlives the state)
   const ChordSet* chords_;      ///< its chords (outlives the state)
@@ -185,6 +186,11 @@ class EliminationState {
     std::vector<uint64_t> old_edges;
   };
   mutable CollapseScratch cs_;
+  // weights() cache: valid while weights_version_[c] == chord_version_[c]
+  std::vector<uint64_t> chord_version_;
+  uint64_t version_counter_ = 1;
+  mutable std::vector<uint64_t> weights_version_;
+  mutable std::vector<ChordWeights> weights_cache_;
   mutable std::vector<ChordStep> scratch_steps_;
   mutable bool sizes_valid_ = false;                     ///< side_sizes_ match the surface
   mutable std::vector<std::array<int32_t, 2>> side_sizes_;  ///< per chord, [left, right]

@@ -78,6 +78,9 @@ EliminationState::EliminationState(const QuadSurface& surface, const ChordSet& c
   rstamp_.assign(nv, 0);
   qstamp_.assign(nq, 0);
   chord_hits_.assign(chords.chords.size(), 0);
+  chord_version_.assign(chords.chords.size(), 1);
+  weights_version_.assign(chords.chords.size(), 0);
+  weights_cache_.resize(chords.chords.size());
 }
 
 int32_t EliminationState::find(int32_t v) const {
@@ -97,7 +100,11 @@ Quad EliminationState::corners(int32_t q) const {
 }
 
 ChordWeights EliminationState::weights(int32_t c) const {
-  ChordWeights w;
+  // cached until a quad of c changes (alive flag or edge weights: touch_quad)
+  if (weights_version_[c] == chord_version_[c]) return weights_cache_[c];
+  ChordWeights& w = weights_cache_[c];
+  w = ChordWeights{};
+  weights_version_[c] = chord_version_[c];
   for (const ChordStep& s : chords_->chords[c].steps) {
     if (!quad_alive_[s.quad]) continue;
     ++w.length;
@@ -544,6 +551,14 @@ void EliminationState::set_opp(int32_t he, int32_t value) {
 void EliminationState::set_weight(int32_t he, const EdgeWeight& w) {
   log_.push_back({LogEntry::weight, he, 0, weight_[he]});
   weight_[he] = w;
+  touch_quad(he >> 2);
+}
+
+void EliminationState::touch_quad(int32_t q) {
+  // both chords through q read q's alive flag and edge weights
+  const uint64_t v = ++version_counter_;
+  chord_version_[chords_->chord_of[2 * q]] = v;
+  chord_version_[chords_->chord_of[2 * q + 1]] = v;
 }
 
 PlanStep EliminationState::apply(int32_t c, int side) {
@@ -641,6 +656,7 @@ void EliminationState::collapse(int32_t c) {
   for (const ChordStep& s : steps) {
     log_.push_back({LogEntry::quad, s.quad, quad_alive_[s.quad], {}});
     quad_alive_[s.quad] = 0;
+    touch_quad(s.quad);
     int32_t d = chords_->chord_of[2 * s.quad + ((s.edge + 1) & 1)];
     log_.push_back({LogEntry::chord, d, chord_len_[d], {}});
     --chord_len_[d];
@@ -661,11 +677,15 @@ void EliminationState::undo() {
     const LogEntry& e = log_.back();
     switch (e.kind) {
       case LogEntry::opp: opp_[e.index] = e.old_int; break;
-      case LogEntry::weight: weight_[e.index] = e.old_weight; break;
+      case LogEntry::weight:
+        weight_[e.index] = e.old_weight;
+        touch_quad(e.index >> 2);
+        break;
       case LogEntry::parent: uf_parent_[e.index] = e.old_int; break;
       case LogEntry::rank: uf_rank_[e.index] = static_cast<int8_t>(e.old_int); break;
       case LogEntry::quad:
         quad_alive_[e.index] = static_cast<uint8_t>(e.old_int);
+        touch_quad(e.index);
         ++alive_quads_;
         break;
       case LogEntry::chord:

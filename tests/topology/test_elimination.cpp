@@ -265,3 +265,46 @@ TEST(Elimination, FluxSideSizesEqualSearchedRegions) {
   }
   EXPECT_GT(compared, 200);
 }
+
+TEST(Elimination, CachedWeightsMatchAFreshState) {
+  // weights() is cached per chord and invalidated by collapses and undos; after a random walk
+  // of applies and undos it must equal the weights of a fresh state with the same chords gone.
+  int compared = 0;
+  for (const auto& g : small_surfaces()) {
+    Prepared p = prepare(g.surface);
+    for (uint64_t seed = 1; seed <= 4; ++seed) {
+      EliminationState st(p.surface, p.chords, p.edges);
+      std::mt19937_64 rng(seed);
+      std::vector<int32_t> path;
+      for (int step = 0; step < 60 && st.alive_chords() > 3; ++step) {
+        for (int32_t c = 0; c < st.num_chords(); ++c)
+          if (st.chord_alive(c)) st.weights(c);  // warm the cache
+        if (!path.empty() && rng() % 3 == 0) {
+          st.undo();
+          path.pop_back();
+        } else {
+          std::vector<int32_t> feasible;
+          for (int32_t c = 0; c < st.num_chords(); ++c)
+            if (st.chord_alive(c) && st.feasibility(c).ok()) feasible.push_back(c);
+          if (feasible.empty()) break;
+          const int32_t c = feasible[rng() % feasible.size()];
+          st.collapse(c);
+          path.push_back(c);
+        }
+        EliminationState fresh(p.surface, p.chords, p.edges);
+        for (int32_t c : path) fresh.collapse(c);
+        for (int32_t c = 0; c < st.num_chords(); ++c) {
+          if (!st.chord_alive(c)) continue;
+          const ChordWeights a = st.weights(c), b = fresh.weights(c);
+          ++compared;
+          ASSERT_EQ(a.length, b.length) << g.name << " chord " << c;
+          ASSERT_EQ(a.sharp, b.sharp) << g.name << " chord " << c;
+          ASSERT_EQ(a.convex, b.convex) << g.name << " chord " << c;
+          ASSERT_EQ(a.concave, b.concave) << g.name << " chord " << c;
+          ASSERT_EQ(a.crossing_sharp, b.crossing_sharp) << g.name << " chord " << c;
+        }
+      }
+    }
+  }
+  EXPECT_GT(compared, 1000);
+}
