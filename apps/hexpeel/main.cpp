@@ -161,8 +161,10 @@ int cmd_mesh(const std::string& in, const std::string& out, const std::string& r
     if (q.sj_count_nonpositive > 0) {
       if (params.untangle.untangle)
         std::printf("note: %d hexes are inverted or degenerate after untangling (%d corners are "
-                    "fixed by the boundary at det <= 0; try --pillow all)\n",
-                    q.sj_count_nonpositive, r.untangle.forced_nonpositive);
+                    "fixed by the boundary at det <= 0%s)\n",
+                    q.sj_count_nonpositive, r.untangle.forced_nonpositive,
+                    r.pillow.whole_boundary ? "; the whole boundary is pillowed already"
+                                            : "; try --pillow all");
       else
         std::printf("note: interior vertices are placed by a harmonic solve only (--no-untangle); "
                     "%d hexes are inverted or degenerate\n", q.sj_count_nonpositive);

@@ -12,7 +12,10 @@
 #include <Eigen/Sparse>
 #include <Eigen/IterativeLinearSolvers>
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
+#include <array>
 #include <chrono>
 
 namespace hexpeel {
@@ -81,20 +84,23 @@ PlacementResult run_placement(const QuadSurface& surface, const HexComplex& comp
     Eigen::SparseMatrix<double> L(nu, nu);
     L.setFromTriplets(trip.begin(), trip.end());
     // Conjugate gradients (diagonal preconditioner): a direct factorization of a 3D Laplacian
-    // fills in badly (minutes and gigabytes at 100k hexes); CG needs only the matrix. Single
+    // fills in badly (minutes and gigabytes at 100k hexes); CG needs only the matrix. The three
+    // coordinates are independent solves, one solver each, run in parallel: each is single
     // threaded, hence deterministic.
-    Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper> solver;
-    solver.setTolerance(params.solver_tolerance);
-    solver.setMaxIterations(std::max<int32_t>(1000, 10 * nu));
-    solver.compute(L);
     Eigen::MatrixXd x(nu, 3);
-    for (int d = 0; d < 3; ++d) {
+    std::array<bool, 3> converged{};
+    tbb::parallel_for(0, 3, [&](int d) {
+      Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper> solver;
+      solver.setTolerance(params.solver_tolerance);
+      solver.setMaxIterations(std::max<int32_t>(1000, 10 * nu));
+      solver.compute(L);
       x.col(d) = solver.solve(rhs.col(d));
-      if (solver.info() != Eigen::Success) {
-        res.status = Status::error(StatusCode::internal_error,
-                                   "placement: the Laplacian solve did not converge");
-        return res;
-      }
+      converged[d] = solver.info() == Eigen::Success;
+    });
+    if (!(converged[0] && converged[1] && converged[2])) {
+      res.status = Status::error(StatusCode::internal_error,
+                                 "placement: the Laplacian solve did not converge");
+      return res;
     }
     for (int32_t v = 0; v < nv; ++v)
       if (unknown[v] >= 0) res.mesh.points[v] = x.row(unknown[v]).transpose();
