@@ -56,6 +56,7 @@ struct PlannerStats {
   double best_cost = 0.0;         ///< cost of the chosen plan
   std::string strategy;           ///< which strategy found it: greedy, window, conflict, beam, restart
   double time_s = 0.0;
+  double first_plan_s = 0.0;      ///< time until the first complete plan (0 = none found)
   bool budget_exhausted = false;
 };
 

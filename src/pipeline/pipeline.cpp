@@ -174,7 +174,8 @@ nlohmann::json to_json(const MeshResult& r) {
                     {"best_cost", r.planner.best_cost},
                     {"strategy", r.planner.strategy},
                     {"budget_exhausted", r.planner.budget_exhausted},
-                    {"time_s", r.planner.time_s}};
+                    {"time_s", r.planner.time_s},
+                    {"first_plan_s", r.planner.first_plan_s}};
   }
   j["reconstruction"] = {{"hexes", r.reconstruction.hexes},
                          {"slit_edges", r.reconstruction.slit_edges},

@@ -122,6 +122,7 @@ struct Search {
   }
 
   void record_plan(const char* strategy) {
+    if (stats.plans_tried == 0) stats.first_plan_s = elapsed();
     ++stats.plans_tried;
     if (cost < best_cost) {
       best_cost = cost;
@@ -303,6 +304,7 @@ struct Search {
     while (!level.empty()) {
       for (Node& n : level)
         if (n.state.alive_chords() <= 3) {
+          if (stats.plans_tried == 0) stats.first_plan_s = elapsed();
           ++stats.plans_tried;
           if (n.cost < best_cost) {
             best_cost = n.cost;
