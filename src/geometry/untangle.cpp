@@ -8,7 +8,9 @@
 //     sum  tr(J^T J) / chi(det J, eps)^(2/3) + lambda (det^2 + 1) / chi(det J, eps),
 //     chi(D, eps) = (D + sqrt(eps^2 + D^2)) / 2,
 // with the papers' epsilon update after each inner minimization (eps follows the worst corner
-// down to 0). The inner minimizer is L-BFGS or projected Newton (UntangleParams::solver): the
+// down to 0); by default phase 1 ends at the first round that leaves every corner positive
+// (UntangleParams::relax_after_untangle) and phase 2 does the remaining relaxation. The inner
+// minimizer is L-BFGS or projected Newton (UntangleParams::solver): the
 // corner Hessians in closed form with negative eigenvalues clamped (untangle_kernels.h),
 // assembled into a sparse matrix over the free vertices, factorized by CHOLMOD (symbolic analysis
 // once per run, numeric factorization per iteration), Armijo backtracking from the full step.
@@ -16,12 +18,18 @@
 // sign: they are left out of the energy and out of the eps schedule (DESIGN.md "Geometry"),
 // otherwise eps would never reach 0. Phase 2 minimizes sum exp(beta (s_min - s)) over the corner
 // scaled Jacobians s = det / (|e0||e1||e2|) (a smoothed minimum); any trial point with a corner
-// s <= 0 has energy +inf, so the line search never accepts an inverting step.
+// s <= 0 has energy +inf, so the line search never accepts an inverting step. Each phase 2
+// restart moves only the vertices around the corners near the minimum (focus_width, focus_rings)
+// and pins the rest, a much smaller problem on large meshes whose bad hexes are local.
+// Evaluation runs hex by hex with batched kernels (untangle_kernels.h: the 8 corners' sqrt,
+// division and cube root chains are independent, and the cube root is a few Newton steps, not
+// libm's cbrt).
 //
 // Input: any hex mesh with finite points; `fixed` marks pinned vertices. Output: the same mesh
-// with free vertices moved; fixed points are copied, never recomputed. Determinism: per-corner
-// terms are written to their own slots, energies summed over fixed blocks in block order, and
-// per-vertex gradients gathered in a fixed incidence order, the Hessian assembled colour by colour
+// with free vertices moved; fixed points are copied, never recomputed. Determinism: per-hex
+// gradients are written to their own slots, energies summed over fixed blocks of hexes in block
+// order, per-vertex gradients gathered in a fixed incidence order, the phase 2 regions chosen
+// from those values alone, the Hessian assembled colour by colour
 // (NewtonSystem), and CHOLMOD does not see the TBB thread count, so any thread count gives the
 // same bytes.
 #include "hexpeel/untangle.h"
@@ -61,63 +69,81 @@ using untangle_detail::Mat9;
 using untangle_detail::QualityKernel;
 using untangle_detail::WinslowKernel;
 using Clock = std::chrono::steady_clock;
-constexpr int32_t kBlock = 2048;  // corners per reduction block (fixed: keeps sums deterministic)
+constexpr int32_t kBlock = 256;  // hexes per reduction block (fixed: keeps sums deterministic)
 
 double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-/// The optimization problem on flat arrays.
+/// The optimization problem on flat arrays. Evaluation runs hex by hex (the 8 points loaded
+/// once, the corners' gradients summed per hex into 8 slots), then gathers each unknown's slots.
 struct Problem {
   std::vector<Vec3> base;                        ///< all points, scaled: (p - centre) / h
   std::vector<int32_t> free_index;               ///< point -> unknown index, -1 if fixed
   std::vector<int32_t> free_point;               ///< unknown index -> point
   std::vector<std::array<int32_t, 4>> corners;   ///< active corners: (c, n0, n1, n2) point ids
-  std::vector<int32_t> inc_start;                ///< CSR over unknowns: slots 4*corner+k using it
-  std::vector<int32_t> inc_slot;
   std::vector<int32_t> group_start;              ///< corners of one hex: [group_start[i], [i+1])
+  std::vector<Hex> hexes;                        ///< hexes with an active corner (group order)
+  std::vector<uint8_t> hex_mask;                 ///< bit c: corner c of that hex is active
+  std::vector<int32_t> inc_start;                ///< CSR over unknowns: slots 8*hex+k using it
+  std::vector<int32_t> inc_slot;
   // work arrays (sized once, reused by every evaluation)
   std::vector<Vec3> pos;                         ///< current positions of all points
-  std::vector<double> corner_f;                  ///< per-corner energy
-  std::vector<double> corner_det;                ///< per-corner det (phase 1) or s (phase 2)
-  std::vector<Vec3> corner_g;                    ///< 4 gradients per corner (slot 4*corner+k)
+  std::vector<Vec3> hex_g;                       ///< gradient per hex and local point (8 slots)
   std::vector<double> block_sum;                 ///< per-block energy sums
+  std::vector<double> block_min;                 ///< per-block min of det (phase 1) or s (phase 2)
   int evaluations = 0;                           ///< energy + gradient evaluations so far
+  int64_t corner_evaluations = 0;                ///< active corners times evaluations so far
 
   int32_t num_corners() const { return static_cast<int32_t>(corners.size()); }
-  int32_t num_blocks() const { return (num_corners() + kBlock - 1) / kBlock; }
+  int32_t num_hexes() const { return static_cast<int32_t>(hexes.size()); }
+  int32_t num_blocks() const { return (num_hexes() + kBlock - 1) / kBlock; }
 
-  void set_positions(const Eigen::VectorXd& x) {
+  /// Sets up the incidence CSR and the work arrays once hexes / hex_mask are filled.
+  void finish_setup() {
+    const int32_t ng = num_hexes();
+    const int32_t nu = static_cast<int32_t>(free_point.size());
+    inc_start.assign(nu + 1, 0);
+    for (const Hex& h : hexes)
+      for (int32_t v : h)
+        if (free_index[v] >= 0) ++inc_start[free_index[v] + 1];
+    for (int32_t u = 0; u < nu; ++u) inc_start[u + 1] += inc_start[u];
+    inc_slot.resize(inc_start[nu]);
+    std::vector<int32_t> fill(inc_start.begin(), inc_start.end() - 1);
+    for (int32_t g = 0; g < ng; ++g)
+      for (int k = 0; k < 8; ++k) {
+        const int32_t u = free_index[hexes[g][k]];
+        if (u >= 0) inc_slot[fill[u]++] = 8 * g + k;
+      }
     pos = base;
+    hex_g.resize(8 * static_cast<size_t>(ng));
+    block_sum.resize(num_blocks());
+    block_min.resize(num_blocks());
+  }
+  void set_positions(const Eigen::VectorXd& x) {
     for (size_t i = 0; i < free_point.size(); ++i) pos[free_point[i]] = x.segment<3>(3 * i);
   }
 
-  /// Evaluates sum of kernel(corner) (energy, det, 4 gradients) and gathers the gradient.
+  /// Evaluates the sum of kernel.hex over the hexes (energy, per-hex gradients, block minima)
+  /// and gathers the gradient per unknown.
   template <typename Kernel>
   double evaluate(const Eigen::VectorXd& x, Eigen::VectorXd& grad, const Kernel& kernel) {
     ++evaluations;
+    corner_evaluations += num_corners();
     set_positions(x);
-    const int32_t nb = num_blocks();
+    const int32_t nb = num_blocks(), nh = num_hexes();
     tbb::parallel_for(tbb::blocked_range<int32_t>(0, nb), [&](const tbb::blocked_range<int32_t>& r) {
       for (int32_t b = r.begin(); b != r.end(); ++b) {
-        double s = 0.0;
-        const int32_t end = std::min(num_corners(), (b + 1) * kBlock);
-        for (int32_t c = b * kBlock; c < end; ++c) {
-          const auto& k = corners[c];
-          const Vec3 e0 = pos[k[1]] - pos[k[0]], e1 = pos[k[2]] - pos[k[0]],
-                     e2 = pos[k[3]] - pos[k[0]];
-          Vec3 g0, g1, g2;
-          double det;
-          const double f = kernel(e0, e1, e2, g0, g1, g2, det);
-          corner_f[c] = f;
-          corner_det[c] = det;
-          corner_g[4 * c + 0] = -(g0 + g1 + g2);
-          corner_g[4 * c + 1] = g0;
-          corner_g[4 * c + 2] = g1;
-          corner_g[4 * c + 3] = g2;
-          s += f;
+        double s = 0.0, m = std::numeric_limits<double>::infinity();
+        const int32_t end = std::min(nh, (b + 1) * kBlock);
+        for (int32_t h = b * kBlock; h < end; ++h) {
+          Vec3 p[8], gh[8];
+          for (int k = 0; k < 8; ++k) p[k] = pos[hexes[h][k]], gh[k].setZero();
+          s += kernel.hex(p, hex_mask[h], gh, m);
+          for (int k = 0; k < 8; ++k) hex_g[8 * static_cast<size_t>(h) + k] = gh[k];
         }
         block_sum[b] = s;
+        block_min[b] = m;
       }
     });
     double total = 0.0;
@@ -126,19 +152,92 @@ struct Problem {
     tbb::parallel_for(tbb::blocked_range<int32_t>(0, nu, 1024), [&](const tbb::blocked_range<int32_t>& r) {
       for (int32_t u = r.begin(); u != r.end(); ++u) {
         Vec3 g = Vec3::Zero();
-        for (int32_t i = inc_start[u]; i < inc_start[u + 1]; ++i) g += corner_g[inc_slot[i]];
+        for (int32_t i = inc_start[u]; i < inc_start[u + 1]; ++i) g += hex_g[inc_slot[i]];
         grad.segment<3>(3 * u) = g;
       }
     });
     return total;
   }
 
+  /// Per hex, the min scaled Jacobian of its active corners at the current positions.
+  void hex_min_value(std::vector<double>& out) const {
+    out.resize(hexes.size());
+    tbb::parallel_for(tbb::blocked_range<int32_t>(0, num_hexes(), 1024),
+                      [&](const tbb::blocked_range<int32_t>& r) {
+      for (int32_t h = r.begin(); h != r.end(); ++h) {
+        double m = std::numeric_limits<double>::infinity();
+        for (int c = 0; c < 8; ++c) {
+          if (!(hex_mask[h] >> c & 1u)) continue;
+          const auto& fr = kHexCornerFrames[c];
+          const Vec3& p = pos[hexes[h][c]];
+          const Vec3 e0 = pos[hexes[h][fr[0]]] - p, e1 = pos[hexes[h][fr[1]]] - p,
+                     e2 = pos[hexes[h][fr[2]]] - p;
+          const double l = std::sqrt(e0.squaredNorm() * e1.squaredNorm() * e2.squaredNorm());
+          m = std::min(m, l > 1e-300 ? e0.dot(e1.cross(e2)) / l : -1.0);
+        }
+        out[h] = m;
+      }
+    });
+  }
+
+  /// Min over the active corners of det (phase 1) or s (phase 2) at the last evaluation.
   double min_corner_value() const {
     double m = std::numeric_limits<double>::infinity();
-    for (double d : corner_det) m = std::min(m, d);
+    for (double d : block_min) m = std::min(m, d);
     return m;
   }
 };
+
+/// Fills `prob` (whose `base` holds the scaled points) for the free vertices of `fixed`: the
+/// active corners, grouped by hex (Newton assembly), and the evaluation layout. A corner whose 4
+/// points are fixed, or whose 3 fixed points are collinear, cannot change its sign and is left
+/// out; `forced` / `forced_nonpositive` (optional) count those and the ones with det <= 0.
+void build_problem(Problem& prob, const std::vector<Hex>& hexes, const std::vector<uint8_t>& fixed,
+                   double collinear_tol, int32_t* forced, int32_t* forced_nonpositive) {
+  const int32_t np = static_cast<int32_t>(prob.base.size());
+  prob.free_index.assign(np, -1);
+  prob.free_point.clear();
+  for (int32_t v = 0; v < np; ++v)
+    if (!fixed[v]) {
+      prob.free_index[v] = static_cast<int32_t>(prob.free_point.size());
+      prob.free_point.push_back(v);
+    }
+  prob.corners.clear();
+  prob.hexes.clear();
+  prob.hex_mask.clear();
+  prob.group_start.assign(1, 0);
+  for (const Hex& h : hexes) {
+    uint8_t mask = 0;
+    for (int c = 0; c < 8; ++c) {
+      const std::array<int32_t, 4> k{h[c], h[kHexCornerFrames[c][0]], h[kHexCornerFrames[c][1]],
+                                     h[kHexCornerFrames[c][2]]};
+      int nfix = 0;
+      std::array<int32_t, 4> fx{};
+      for (int32_t v : k)
+        if (fixed[v]) fx[nfix++] = v;
+      bool is_forced = nfix == 4;
+      if (nfix == 3) {
+        const Vec3 a = prob.base[fx[1]] - prob.base[fx[0]], b = prob.base[fx[2]] - prob.base[fx[0]];
+        is_forced = a.cross(b).norm() <= collinear_tol * a.norm() * b.norm();
+      }
+      if (is_forced) {
+        if (forced) ++*forced;
+        const Vec3 e0 = prob.base[k[1]] - prob.base[k[0]], e1 = prob.base[k[2]] - prob.base[k[0]],
+                   e2 = prob.base[k[3]] - prob.base[k[0]];
+        if (forced_nonpositive && e0.dot(e1.cross(e2)) <= 0.0) ++*forced_nonpositive;
+      } else {
+        prob.corners.push_back(k);
+        mask |= static_cast<uint8_t>(1u << c);
+      }
+    }
+    if (mask != 0) {
+      prob.group_start.push_back(static_cast<int32_t>(prob.corners.size()));
+      prob.hexes.push_back(h);
+      prob.hex_mask.push_back(mask);
+    }
+  }
+  prob.finish_setup();
+}
 
 /// Runs L-BFGS on `kernel` from x; x ends at the lowest finite energy seen. Returns iterations.
 template <typename Kernel>
@@ -452,64 +551,14 @@ UntangleResult run_untangle(const HexMesh& mesh, const std::vector<uint8_t>& fix
   prob.base.resize(np);
   for (int32_t v = 0; v < np; ++v) prob.base[v] = (mesh.points[v] - centre) / unit;
 
-  prob.free_index.assign(np, -1);
-  for (int32_t v = 0; v < np; ++v)
-    if (!fixed[v]) {
-      prob.free_index[v] = static_cast<int32_t>(prob.free_point.size());
-      prob.free_point.push_back(v);
-    }
-  const int32_t nu = static_cast<int32_t>(prob.free_point.size());
+  int32_t forced = 0, forced_nonpositive = 0;
+  build_problem(prob, mesh.hexes, fixed, params.collinear_tol, &forced, &forced_nonpositive);
+  const int32_t nu = static_cast<int32_t>(prob.free_point.size()), nc = prob.num_corners();
   res.stats.solver = params.solver;
   res.stats.free_vertices = nu;
-
-  // Active and forced corners; the active corners of one hex form a group (Newton assembly).
-  prob.group_start.push_back(0);
-  for (const Hex& h : mesh.hexes) {
-    for (int c = 0; c < 8; ++c) {
-      const std::array<int32_t, 4> k{h[c], h[kHexCornerFrames[c][0]], h[kHexCornerFrames[c][1]],
-                                     h[kHexCornerFrames[c][2]]};
-      int nfix = 0;
-      std::array<int32_t, 4> fx{};
-      for (int32_t v : k)
-        if (fixed[v]) fx[nfix++] = v;
-      bool forced = nfix == 4;
-      if (nfix == 3) {
-        const Vec3 a = prob.base[fx[1]] - prob.base[fx[0]], b = prob.base[fx[2]] - prob.base[fx[0]];
-        forced = a.cross(b).norm() <= params.collinear_tol * a.norm() * b.norm();
-      }
-      if (forced) {
-        ++res.stats.forced_corners;
-        const Vec3 e0 = prob.base[k[1]] - prob.base[k[0]], e1 = prob.base[k[2]] - prob.base[k[0]],
-                   e2 = prob.base[k[3]] - prob.base[k[0]];
-        if (e0.dot(e1.cross(e2)) <= 0.0) ++res.stats.forced_nonpositive;
-      } else {
-        prob.corners.push_back(k);
-      }
-    }
-    if (static_cast<int32_t>(prob.corners.size()) > prob.group_start.back())
-      prob.group_start.push_back(static_cast<int32_t>(prob.corners.size()));
-  }
-  const int32_t nc = prob.num_corners();
+  res.stats.forced_corners = forced;
+  res.stats.forced_nonpositive = forced_nonpositive;
   res.stats.active_corners = nc;
-  // Incidence CSR: for each unknown, the corner slots that use it, in corner order.
-  prob.inc_start.assign(nu + 1, 0);
-  for (const auto& k : prob.corners)
-    for (int32_t v : k)
-      if (prob.free_index[v] >= 0) ++prob.inc_start[prob.free_index[v] + 1];
-  for (int32_t u = 0; u < nu; ++u) prob.inc_start[u + 1] += prob.inc_start[u];
-  prob.inc_slot.resize(prob.inc_start[nu]);
-  {
-    std::vector<int32_t> fill(prob.inc_start.begin(), prob.inc_start.end() - 1);
-    for (int32_t c = 0; c < nc; ++c)
-      for (int k = 0; k < 4; ++k) {
-        const int32_t u = prob.free_index[prob.corners[c][k]];
-        if (u >= 0) prob.inc_slot[fill[u]++] = 4 * c + k;
-      }
-  }
-  prob.corner_f.resize(nc);
-  prob.corner_det.resize(nc);
-  prob.corner_g.resize(4 * static_cast<size_t>(nc));
-  prob.block_sum.resize(prob.num_blocks());
   if (nu == 0 || nc == 0) {
     res.stats.time_s = seconds_since(t_start);
     res.stats.optimize.min_sj_before = res.stats.optimize.min_sj_after = q0.min;
@@ -528,6 +577,7 @@ UntangleResult run_untangle(const HexMesh& mesh, const std::vector<uint8_t>& fix
   if (params.untangle) {
     const auto t1 = Clock::now();
     const int ev0 = prob.evaluations;
+    const int64_t cev0 = prob.corner_evaluations;
     WinslowKernel k{1.0, params.lambda};
     prob.evaluate(x, g, k);
     double detmin = prob.min_corner_value();
@@ -549,12 +599,15 @@ UntangleResult run_untangle(const HexMesh& mesh, const std::vector<uint8_t>& fix
       ++res.stats.untangle.rounds;
       ctx.report("untangle", std::min(1.0, (round + 1.0) / params.max_outer));
       if (detmin > 0 && std::abs(e_prev - e) <= params.energy_rtol * std::abs(e)) break;
+      // Untangled: phase 2 (whose objective includes this energy at eps ~ 0) takes over.
+      if (detmin > 0 && !params.relax_after_untangle && params.optimize) break;
       const double sigma = std::max(1.0 - e / e_prev, 0.1);
       const double mu = (1.0 - sigma) * chi(detmin, k.eps);
       k.eps = detmin < mu ? 2.0 * std::sqrt(mu * (mu - detmin)) : 1e-10;
     }
     res.stats.final_eps = k.eps;
     res.stats.untangle.evaluations = prob.evaluations - ev0;
+    res.stats.untangle.corner_evaluations = prob.corner_evaluations - cev0;
     write_back(x);
     const HexQuality q1 = hex_quality(res.mesh);
     res.stats.untangle.min_sj_after = q1.min;
@@ -570,16 +623,56 @@ UntangleResult run_untangle(const HexMesh& mesh, const std::vector<uint8_t>& fix
   if (params.optimize) {
     const auto t2 = Clock::now();
     const int ev0 = prob.evaluations;
+    const int64_t cev0 = prob.corner_evaluations;
     const Eigen::VectorXd x_before = x;
     QualityKernel k{params.beta, 0.0, 0.0, params.regularization, WinslowKernel{1e-10, params.lambda}};
     k.floor = -std::numeric_limits<double>::infinity();
     prob.evaluate(x, g, k);
     double smin = prob.min_corner_value();
+    const bool focus = params.focus_width > 0.0;
+    Problem sub;
+    std::vector<uint8_t> in_region;
+    std::vector<double> hex_s;
     for (int round = 0; round < params.max_quality_rounds; ++round) {
       k.s_ref = smin;
       // Positive meshes stay positive; a mesh with inverted corners may not get worse.
       k.floor = smin > 0 ? 0.0 : smin - 1e-12;
-      res.stats.optimize.iterations += minimize(prob, k, x, params, params.max_quality_inner);
+      if (focus) {
+        // Only corners with s < s_ref + focus_width weigh in the smoothed minimum (the others'
+        // exp terms are below exp(-beta focus_width)): free the vertices of their hexes and
+        // focus_rings rings of hexes around them, pin the rest where it is.
+        prob.hex_min_value(hex_s);
+        in_region.assign(prob.base.size(), 0);
+        for (int32_t h = 0; h < prob.num_hexes(); ++h)
+          if (hex_s[h] < smin + params.focus_width)
+            for (int32_t v : prob.hexes[h]) in_region[v] = 1;
+        for (int ring = 0; ring < params.focus_rings; ++ring) {
+          std::vector<uint8_t> grown = in_region;
+          for (const Hex& h : prob.hexes) {
+            bool touches = false;
+            for (int32_t v : h) touches |= in_region[v] != 0;
+            if (touches)
+              for (int32_t v : h) grown[v] = 1;
+          }
+          in_region.swap(grown);
+        }
+        std::vector<uint8_t> sub_fixed(prob.base.size(), 1);
+        for (int32_t v : prob.free_point) sub_fixed[v] = in_region[v] ? 0 : 1;
+        sub.base = prob.pos;  // prob.pos holds x: evaluate() was last called at x
+        build_problem(sub, prob.hexes, sub_fixed, params.collinear_tol, nullptr, nullptr);
+        const int32_t ns = static_cast<int32_t>(sub.free_point.size());
+        Eigen::VectorXd xs(3 * ns);
+        for (int32_t u = 0; u < ns; ++u) xs.segment<3>(3 * u) = sub.base[sub.free_point[u]];
+        const int ev_sub = sub.evaluations;
+        const int64_t cev_sub = sub.corner_evaluations;
+        res.stats.optimize.iterations += minimize(sub, k, xs, params, params.max_quality_inner);
+        res.stats.optimize.evaluations += sub.evaluations - ev_sub;
+        res.stats.optimize.corner_evaluations += sub.corner_evaluations - cev_sub;
+        for (int32_t u = 0; u < ns; ++u)
+          x.segment<3>(3 * prob.free_index[sub.free_point[u]]) = xs.segment<3>(3 * u);
+      } else {
+        res.stats.optimize.iterations += minimize(prob, k, x, params, params.max_quality_inner);
+      }
       prob.evaluate(x, g, k);
       const double s = prob.min_corner_value();
       ++res.stats.optimize.rounds;
@@ -588,7 +681,8 @@ UntangleResult run_untangle(const HexMesh& mesh, const std::vector<uint8_t>& fix
       smin = std::max(smin, s);
       if (done) break;
     }
-    res.stats.optimize.evaluations = prob.evaluations - ev0;
+    res.stats.optimize.evaluations += prob.evaluations - ev0;
+    res.stats.optimize.corner_evaluations += prob.corner_evaluations - cev0;
     HexMesh before = res.mesh;
     write_back(x);
     const HexQuality q2 = hex_quality(res.mesh);

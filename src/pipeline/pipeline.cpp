@@ -213,6 +213,7 @@ nlohmann::json to_json(const MeshResult& r) {
       return nlohmann::json{{"rounds", s.rounds},
                             {"iterations", s.iterations},
                             {"evaluations", s.evaluations},
+                            {"corner_evaluations", s.corner_evaluations},
                             {"time_s", s.time_s},
                             {"min_sj_before", s.min_sj_before},
                             {"min_sj_after", s.min_sj_after},

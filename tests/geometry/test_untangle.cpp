@@ -103,6 +103,57 @@ TEST(GeometryUntangle, WinslowHessianMatchesFiniteDifferences) {
   EXPECT_GT(convex_seen, 0);
 }
 
+// The cheap cube root: within a few ulp of the library's over the whole normal range, and the
+// library's own value outside it.
+TEST(GeometryUntangle, InvCbrtMatchesLibrary) {
+  for (double e = -299.0; e <= 299.0; e += 0.37) {
+    const double x = std::pow(10.0, e) * (1.0 + 0.5 * std::sin(7.0 * e));
+    const double ref = 1.0 / std::cbrt(x);
+    EXPECT_NEAR(untangle_detail::inv_cbrt(x), ref, 4e-15 * ref) << "x = " << x;
+  }
+  for (double x : {1e-310, 1e305, 8.0, 1.0}) EXPECT_NEAR(untangle_detail::inv_cbrt(x), 1.0 / std::cbrt(x), 4e-15 / std::cbrt(x));
+}
+
+// The batched per-hex kernels give the same energy, gradient and minimum as the per-corner ones
+// (masked corners left out), for upright, inverted and flat hexes.
+TEST(GeometryUntangle, HexKernelsMatchCornerKernels) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> uni(-1.0, 1.0);
+  const Vec3 cube[8] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
+                        {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+  for (int trial = 0; trial < 40; ++trial) {
+    SCOPED_TRACE("trial " + std::to_string(trial));
+    const double amount = trial % 2 == 0 ? 0.2 : 0.7;  // the larger jitter inverts some corners
+    Vec3 p[8];
+    for (int k = 0; k < 8; ++k) p[k] = cube[k] + amount * Vec3(uni(rng), uni(rng), uni(rng));
+    const unsigned mask = trial % 3 == 0 ? 0xffu : static_cast<unsigned>(rng() & 0xffu) | 1u;
+    untangle_detail::WinslowKernel w{trial % 4 == 0 ? 1e-10 : 0.3, 1.0};
+    untangle_detail::QualityKernel q{30.0, 0.2, -std::numeric_limits<double>::infinity(), 0.1,
+                                     untangle_detail::WinslowKernel{1e-10, 1.0}};
+    auto check = [&](const auto& kernel) {
+      Vec3 g_hex[8], g_ref[8];
+      for (int k = 0; k < 8; ++k) g_hex[k].setZero(), g_ref[k].setZero();
+      double min_hex = std::numeric_limits<double>::infinity(), min_ref = min_hex, f_ref = 0.0;
+      const double f_hex = kernel.hex(p, mask, g_hex, min_hex);
+      for (int c = 0; c < 8; ++c) {
+        if (!(mask >> c & 1u)) continue;
+        const auto& fr = kHexCornerFrames[c];
+        Vec3 g0, g1, g2;
+        double v;
+        f_ref += kernel(p[fr[0]] - p[c], p[fr[1]] - p[c], p[fr[2]] - p[c], g0, g1, g2, v);
+        min_ref = std::min(min_ref, v);
+        g_ref[fr[0]] += g0, g_ref[fr[1]] += g1, g_ref[fr[2]] += g2, g_ref[c] -= g0 + g1 + g2;
+      }
+      EXPECT_NEAR(f_hex, f_ref, 1e-12 * std::abs(f_ref));
+      EXPECT_EQ(min_hex, min_ref);
+      for (int k = 0; k < 8; ++k)
+        EXPECT_LE((g_hex[k] - g_ref[k]).norm(), 1e-12 * (1.0 + g_ref[k].norm())) << "point " << k;
+    };
+    check(w);
+    check(q);
+  }
+}
+
 TEST(GeometryUntangle, JitteredGridBecomesPositiveAndBoundaryStays) {
   for (uint64_t seed : {1u, 2u, 3u})
   for (UntangleSolver solver : {UntangleSolver::newton, UntangleSolver::lbfgs}) {
@@ -130,6 +181,56 @@ TEST(GeometryUntangle, JitteredGridBecomesPositiveAndBoundaryStays) {
     EXPECT_EQ(r.stats.forced_nonpositive, 0);
     EXPECT_EQ(r.stats.untangle.nonpositive_after, 0);
   }
+}
+
+// Phase 1 stops at the first round that leaves every corner positive (the papers' rule keeps
+// lowering eps); both end untangled, and phase 2 brings the default to at least the same minimum.
+TEST(GeometryUntangle, PhaseOneStopsOnceUntangled) {
+  Generated g = testing::jittered(testing::cubed_sphere_equiangular(5), 3, 0.3);
+  ASSERT_GT(run_quality(g.known_mesh).sj_count_nonpositive, 0);
+  UntangleParams fast, papers;
+  papers.relax_after_untangle = true;
+  UntangleResult a = run_untangle(g.known_mesh, surface_fixed(g), fast);
+  UntangleResult b = run_untangle(g.known_mesh, surface_fixed(g), papers);
+  EXPECT_EQ(a.stats.untangle.nonpositive_after, 0);
+  EXPECT_EQ(b.stats.untangle.nonpositive_after, 0);
+  EXPECT_LT(a.stats.untangle.rounds, b.stats.untangle.rounds);
+  EXPECT_LT(a.stats.untangle.evaluations, b.stats.untangle.evaluations);
+  EXPECT_EQ(run_quality(a.mesh).sj_count_nonpositive, 0);
+}
+
+// Phase 2 focused on the worst corners: evaluates fewer corner terms than the whole-mesh
+// optimization, keeps every hex positive and does not lower the minimum reached by phase 1.
+TEST(GeometryUntangle, FocusedOptimizeEvaluatesLessAndKeepsQuality) {
+  // A unit-cell grid whose boundary is dented at one vertex (the centre of the bottom face): the
+  // bad corners are all near it, the rest of the grid stays perfect.
+  Generated g = testing::cube(10, 10, 10, 1.0);
+  Vec3 lo = g.known_mesh.points[0], hi = lo;
+  for (const Vec3& p : g.known_mesh.points) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  const Vec3 target(0.5 * (lo.x() + hi.x()), 0.5 * (lo.y() + hi.y()), lo.z());
+  int32_t dent = 0;
+  for (int32_t v = 0; v < g.surface.num_points(); ++v)
+    if ((g.known_mesh.points[v] - target).norm() < (g.known_mesh.points[dent] - target).norm()) dent = v;
+  const double cell = (hi.x() - lo.x()) / 10.0;
+  ASSERT_LT((g.known_mesh.points[dent] - target).norm(), 1e-9 * cell);
+  g.known_mesh.points[dent] += cell * Vec3(0.4, 0.3, 0.6);
+  UntangleParams focused, whole;
+  whole.focus_width = 0.0;
+  UntangleResult a = run_untangle(g.known_mesh, surface_fixed(g), focused);
+  UntangleResult b = run_untangle(g.known_mesh, surface_fixed(g), whole);
+  for (const UntangleResult* r : {&a, &b}) {
+    EXPECT_FALSE(r->stats.optimize_reverted);
+    EXPECT_EQ(r->stats.optimize.nonpositive_after, 0);
+    EXPECT_GE(r->stats.optimize.min_sj_after, r->stats.optimize.min_sj_before);
+    EXPECT_GT(r->stats.optimize.corner_evaluations, 0);
+  }
+  EXPECT_LT(a.stats.optimize.corner_evaluations / std::max(1, a.stats.optimize.evaluations),
+            b.stats.optimize.corner_evaluations / std::max(1, b.stats.optimize.evaluations));
+  // The far corners weigh nothing in the smoothed minimum: pinning them costs little.
+  EXPECT_GE(a.stats.optimize.min_sj_after, b.stats.optimize.min_sj_after - 0.01)
+      << a.stats.optimize.min_sj_after << " vs " << b.stats.optimize.min_sj_after;
+  for (int32_t v = 0; v < g.surface.num_points(); ++v)
+    ASSERT_EQ(a.mesh.points[v], g.known_mesh.points[v]) << "boundary vertex " << v << " moved";
 }
 
 TEST(GeometryUntangle, SameBytesForAnyThreadCount) {
