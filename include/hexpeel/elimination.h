@@ -47,6 +47,10 @@ struct EliminationPlan {
 /// Why no remaining chord of `state` can be eliminated: counts per reason, and a sentence.
 StuckReport diagnose_stuck(const EliminationState& state);
 
+/// ok, or self_intersecting_chord naming the first chord that passes through a quad twice
+/// (dual cycle elimination needs every chord to be simple).
+Status check_simple_chords(const EliminationState& state);
+
 /// Greedy elimination in the paper's order, applied to `state` (fresh from its constructor).
 /// Self-intersecting chords make the status `self_intersecting_chord` at once. Afterwards `state`
 /// holds the final cube, or the stuck surface (for --dump-stuck).

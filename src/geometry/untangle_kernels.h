@@ -36,9 +36,6 @@ inline double chi(double d, double eps) {
   const double r = std::sqrt(eps * eps + d * d);
   return d > 0 ? 0.5 * (d + r) : 0.5 * eps * eps / (r - d);
 }
-inline double chi_deriv(double d, double eps) {
-  return 0.5 + 0.5 * d / std::sqrt(eps * eps + d * d);
-}
 
 /// x^(-1/3) for x > 0, within a few ulp of 1 / std::cbrt(x) but about 4x cheaper (glibc's cbrt
 /// was a quarter of the untangler's time): an exponent-halving bit guess (about 3% off) refined

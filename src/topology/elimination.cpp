@@ -39,6 +39,17 @@ StuckReport diagnose_stuck(const EliminationState& state) {
   return r;
 }
 
+Status check_simple_chords(const EliminationState& state) {
+  const ChordSet& chords = state.chord_set();
+  for (size_t c = 0; c < chords.chords.size(); ++c)
+    if (chords.chords[c].self_intersecting)
+      return Status::error(StatusCode::self_intersecting_chord,
+                           "chord " + std::to_string(c) +
+                               " passes through a quad twice; dual cycle elimination needs every "
+                               "chord to be simple");
+  return Status::success();
+}
+
 EliminationPlan run_elimination(EliminationState& state, const EliminationParams& params,
                                 const Context& ctx) {
   using clock = std::chrono::steady_clock;
@@ -47,14 +58,8 @@ EliminationPlan run_elimination(EliminationState& state, const EliminationParams
   const int32_t nchords = state.num_chords();
   const int32_t total_steps = std::max(1, nchords - 3);
 
-  for (int32_t c = 0; c < nchords; ++c)
-    if (state.feasibility(c).why == Infeasible::self_intersecting) {
-      plan.status = Status::error(StatusCode::self_intersecting_chord,
-                                  "chord " + std::to_string(c) +
-                                      " passes through a quad twice; dual cycle elimination needs "
-                                      "every chord to be simple");
-      return plan;
-    }
+  plan.status = check_simple_chords(state);
+  if (!plan.status.ok()) return plan;
 
   plan.stats.predicted_hexes = 1;
   const OrderPolicy policy(params.order);

@@ -365,18 +365,11 @@ struct Search {
 
 }  // namespace
 
-PlannerResult run_planner(EliminationState& state, const PlannerParams& params_in, const Context& ctx) {
-  PlannerParams params = params_in;
+PlannerResult run_planner(EliminationState& state, const PlannerParams& params, const Context& ctx) {
   PlannerResult res;
   EliminationPlan& plan = res.plan;
-  for (int32_t c = 0; c < state.num_chords(); ++c)
-    if (state.feasibility(c).why == Infeasible::self_intersecting) {
-      plan.status = Status::error(StatusCode::self_intersecting_chord,
-                                  "chord " + std::to_string(c) +
-                                      " passes through a quad twice; dual cycle elimination needs "
-                                      "every chord to be simple");
-      return res;
-    }
+  plan.status = check_simple_chords(state);
+  if (!plan.status.ok()) return res;
   Search s(state, params, ctx);
   // 1. cost-guided greedy with windowed backtracking (at most 15% of the budget)
   s.begin_phase(0.15);
