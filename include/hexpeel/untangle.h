@@ -2,13 +2,15 @@
 //
 // Phase 1 (untangle): the regularized Winslow-type energy of Garanzha, Kaporin, Kudryavtseva,
 // Protais, Ray and Sokolov ("Foldover-free maps in 50 lines of code", ACM TOG 2021; "Untangling and
-// optimization of spatial meshes", 2022) on the 8 corner tetrahedra of every hex, with their
-// epsilon continuation, minimized by L-BFGS or by Newton's method (per-corner Hessians projected
-// to positive semi-definite, sparse Cholesky by CHOLMOD), see UntangleParams::solver.
-// Phase 1 stops once every corner is positive (UntangleParams::relax_after_untangle).
-// Phase 2 (optimize): a smoothed minimum of the corner scaled Jacobians, minimized by L-BFGS
-// whose line search rejects any step that makes a corner non-positive, so no hex positive after
-// phase 1 goes <= 0; each restart moves only the vertices near the worst corners (focus_width).
+// optimization of spatial meshes", 2022) on the 8 corner tetrahedra and the centre Jacobian of
+// every hex (the 9 Jacobians of Verdict's scaled Jacobian), with epsilon continuation
+// (UntangleParams::eps_rule), minimized by L-BFGS or by Newton's method (per-corner Hessians
+// projected to positive semi-definite, sparse Cholesky by CHOLMOD), see UntangleParams::solver.
+// Phase 1 stops once every term is positive (UntangleParams::relax_after_untangle), after
+// max_outer rounds, or when the inverted count stalls (UntangleParams::stall_rounds).
+// Phase 2 (optimize): a smoothed minimum of the 9 scaled Jacobians per hex, minimized by L-BFGS
+// whose line search rejects any step that makes a term non-positive, so no hex positive after
+// phase 1 goes <= 0; each restart moves only the vertices near the worst terms (focus_width).
 // Fixed vertices never move (bit for bit).
 // Same output for any thread count (fixed partitions, per-vertex sums in a fixed order).
 #pragma once
@@ -33,6 +35,18 @@ std::string_view to_string(UntangleSolver s);
 /// "newton" or "lbfgs"; false (and `out` untouched) for anything else.
 bool parse_untangle_solver(std::string_view name, UntangleSolver& out);
 
+/// How phase 1 lowers eps between rounds (det below is the min corner det, in units of the
+/// reference cube).
+enum class EpsRule : uint8_t {
+  /// Garanzha et al. 2021, section 4: eps shrinks by a factor tied to the energy decrease, which
+  /// the paper proves safe; it falls slowly (about 5% a round) while a corner sits near det = -1.
+  theorem,
+  /// eps = sqrt(eps_floor^2 + 0.04 det^2) while det <= 0 (eps follows a fifth of the worst
+  /// corner's det), eps_floor once all are positive; eps_floor starts at 1e-3 and halves every
+  /// 10 rounds. The rule the authors' own code uses by default.
+  tracking,
+};
+
 struct UntangleParams {
   bool untangle = true;   ///< run phase 1 (Winslow energy with epsilon continuation)
   bool optimize = true;   ///< run phase 2 (smoothed-min scaled Jacobian)
@@ -43,7 +57,13 @@ struct UntangleParams {
   /// Newton, whose CHOLMOD factorizations of a 3D mesh's Hessian fill in heavily, and reached the
   /// same result (screw2 stays inverted with both).
   UntangleSolver solver = UntangleSolver::lbfgs;
-  int max_outer = 20;             ///< epsilon continuation rounds in phase 1 (1..10000)
+  /// Phase 1 eps schedule. tracking: screw2 (4869 hexes) untangles in 39 rounds, where theorem
+  /// keeps 358 hexes inverted after 20 rounds and 63 after 300 (issue 6).
+  EpsRule eps_rule = EpsRule::tracking;
+  int max_outer = 100;            ///< at most this many epsilon rounds in phase 1 (1..10000)
+  /// Phase 1 also stops when the number of hexes with a non-positive corner or centre has not
+  /// dropped for this many rounds (0: run all max_outer rounds while any is inverted).
+  int stall_rounds = 20;
   int max_inner = 200;            ///< L-BFGS iterations per round, both phases (1..100000)
   double inner_gtol = 1e-5;       ///< L-BFGS gradient tolerance, relative to |x| (> 0)
   double energy_rtol = 1e-5;      ///< phase 1 stops once all corners are positive and E changes by less

@@ -4,15 +4,19 @@
 // of code" (ACM TOG 2021, sections 3-4) and "Untangling and optimization of spatial meshes" (2022):
 // every hex corner (corner c with its three frame neighbours, kHexCornerFrames) is a tetrahedron
 // with Jacobian J = [e0 e1 e2] / h (e_k = p_{n_k} - p_c, h = a reference edge length, so a unit
-// cube of edge h has J = I). Phase 1 minimizes
+// cube of edge h has J = I), and so is the hex centre (e_k = a quarter of principal axis k), the
+// ninth Jacobian of Verdict's scaled Jacobian: with corners alone a hex can end with 8 positive
+// corners and a negative centre (screw2: 144 hexes). Phase 1 minimizes
 //     sum  tr(J^T J) / chi(det J, eps)^(2/3) + lambda (det^2 + 1) / chi(det J, eps),
 //     chi(D, eps) = (D + sqrt(eps^2 + D^2)) / 2,
-// with the papers' epsilon update after each inner minimization (eps follows the worst corner
-// down to 0); by default phase 1 ends at the first round that leaves every corner positive
+// with an epsilon update after each inner minimization (UntangleParams::eps_rule: by default eps
+// tracks a fifth of the worst det, the rule of the authors' code; the paper's provable rule is
+// the alternative) and a stall test (UntangleParams::stall_rounds); by default phase 1 ends at the first round that leaves every corner positive
 // (UntangleParams::relax_after_untangle) and phase 2 does the remaining relaxation. The inner
 // minimizer is L-BFGS or projected Newton (UntangleParams::solver): the
 // corner Hessians in closed form with negative eigenvalues clamped (untangle_kernels.h),
-// assembled into a sparse matrix over the free vertices, factorized by CHOLMOD (symbolic analysis
+// assembled into a sparse matrix over the free vertices (corner terms only: the centre terms'
+// Hessians are left out, which keeps the matrix PSD and its pattern that of the corners), factorized by CHOLMOD (symbolic analysis
 // once per run, numeric factorization per iteration), Armijo backtracking from the full step.
 // Corners whose 4 points are all fixed, or whose fixed points are collinear, cannot change their
 // sign: they are left out of the energy and out of the eps schedule (DESIGN.md "Geometry"),
@@ -84,7 +88,9 @@ struct Problem {
   std::vector<std::array<int32_t, 4>> corners;   ///< active corners: (c, n0, n1, n2) point ids
   std::vector<int32_t> group_start;              ///< corners of one hex: [group_start[i], [i+1])
   std::vector<Hex> hexes;                        ///< hexes with an active corner (group order)
-  std::vector<uint8_t> hex_mask;                 ///< bit c: corner c of that hex is active
+  /// bit c: corner c of that hex is active; bit kCentre: its centre Jacobian is (some point free)
+  std::vector<uint16_t> hex_mask;
+  int32_t num_centres = 0;                       ///< hexes whose centre term is active
   std::vector<int32_t> inc_start;                ///< CSR over unknowns: slots 8*hex+k using it
   std::vector<int32_t> inc_slot;
   // work arrays (sized once, reused by every evaluation)
@@ -129,7 +135,7 @@ struct Problem {
   template <typename Kernel>
   double evaluate(const Eigen::VectorXd& x, Eigen::VectorXd& grad, const Kernel& kernel) {
     ++evaluations;
-    corner_evaluations += num_corners();
+    corner_evaluations += num_corners() + num_centres;
     set_positions(x);
     const int32_t nb = num_blocks(), nh = num_hexes();
     tbb::parallel_for(tbb::blocked_range<int32_t>(0, nb), [&](const tbb::blocked_range<int32_t>& r) {
@@ -159,21 +165,22 @@ struct Problem {
     return total;
   }
 
-  /// Per hex, the min scaled Jacobian of its active corners at the current positions.
+  /// Per hex, the min scaled Jacobian of its active terms (corners, centre) at the current
+  /// positions.
   void hex_min_value(std::vector<double>& out) const {
     out.resize(hexes.size());
     tbb::parallel_for(tbb::blocked_range<int32_t>(0, num_hexes(), 1024),
                       [&](const tbb::blocked_range<int32_t>& r) {
       for (int32_t h = r.begin(); h != r.end(); ++h) {
+        Vec3 p[8];
+        for (int k = 0; k < 8; ++k) p[k] = pos[hexes[h][k]];
+        untangle_detail::HexCorners hc;
+        hc.load(p, hex_mask[h]);
         double m = std::numeric_limits<double>::infinity();
-        for (int c = 0; c < 8; ++c) {
-          if (!(hex_mask[h] >> c & 1u)) continue;
-          const auto& fr = kHexCornerFrames[c];
-          const Vec3& p = pos[hexes[h][c]];
-          const Vec3 e0 = pos[hexes[h][fr[0]]] - p, e1 = pos[hexes[h][fr[1]]] - p,
-                     e2 = pos[hexes[h][fr[2]]] - p;
-          const double l = std::sqrt(e0.squaredNorm() * e1.squaredNorm() * e2.squaredNorm());
-          m = std::min(m, l > 1e-300 ? e0.dot(e1.cross(e2)) / l : -1.0);
+        for (int i = 0; i < hc.n; ++i) {
+          const double l = std::sqrt(hc.e[i][0].squaredNorm() * hc.e[i][1].squaredNorm() *
+                                     hc.e[i][2].squaredNorm());
+          m = std::min(m, l > 1e-300 ? hc.det[i] / l : -1.0);
         }
         out[h] = m;
       }
@@ -206,8 +213,9 @@ void build_problem(Problem& prob, const std::vector<Hex>& hexes, const std::vect
   prob.hexes.clear();
   prob.hex_mask.clear();
   prob.group_start.assign(1, 0);
+  prob.num_centres = 0;
   for (const Hex& h : hexes) {
-    uint8_t mask = 0;
+    uint16_t mask = 0;
     for (int c = 0; c < 8; ++c) {
       const std::array<int32_t, 4> k{h[c], h[kHexCornerFrames[c][0]], h[kHexCornerFrames[c][1]],
                                      h[kHexCornerFrames[c][2]]};
@@ -227,8 +235,15 @@ void build_problem(Problem& prob, const std::vector<Hex>& hexes, const std::vect
         if (forced_nonpositive && e0.dot(e1.cross(e2)) <= 0.0) ++*forced_nonpositive;
       } else {
         prob.corners.push_back(k);
-        mask |= static_cast<uint8_t>(1u << c);
+        mask |= static_cast<uint16_t>(1u << c);
       }
+    }
+    // The centre Jacobian depends on all 8 points: it can change unless all are fixed.
+    bool any_free = false;
+    for (int32_t v : h) any_free |= !fixed[v];
+    if (any_free) {
+      mask |= static_cast<uint16_t>(1u << untangle_detail::kCentre);
+      ++prob.num_centres;
     }
     if (mask != 0) {
       prob.group_start.push_back(static_cast<int32_t>(prob.corners.size()));
@@ -581,9 +596,18 @@ UntangleResult run_untangle(const HexMesh& mesh, const std::vector<uint8_t>& fix
     WinslowKernel k{1.0, params.lambda};
     prob.evaluate(x, g, k);
     double detmin = prob.min_corner_value();
-    k.eps = detmin > 0 ? 1e-10 : 1.0;
+    // eps_floor: the tracking rule's eps once every corner is positive, halved every 10 rounds.
+    double eps_floor = 1e-3;
+    auto tracking_eps = [&] {
+      return detmin > 0 ? eps_floor : std::sqrt(eps_floor * eps_floor + 0.04 * detmin * detmin);
+    };
+    if (params.eps_rule == EpsRule::tracking) k.eps = tracking_eps();
+    else k.eps = detmin > 0 ? 1e-10 : 1.0;
     NewtonSystem sys;
     if (params.solver == UntangleSolver::newton) sys.build(prob, params.supernodal);
+    std::vector<double> hex_s;
+    int32_t best_bad = std::numeric_limits<int32_t>::max();
+    int best_round = 0;
     for (int round = 0; round < params.max_outer; ++round) {
       const double e_prev = prob.evaluate(x, g, k);
       if (params.solver == UntangleSolver::newton) {
@@ -601,9 +625,22 @@ UntangleResult run_untangle(const HexMesh& mesh, const std::vector<uint8_t>& fix
       if (detmin > 0 && std::abs(e_prev - e) <= params.energy_rtol * std::abs(e)) break;
       // Untangled: phase 2 (whose objective includes this energy at eps ~ 0) takes over.
       if (detmin > 0 && !params.relax_after_untangle && params.optimize) break;
-      const double sigma = std::max(1.0 - e / e_prev, 0.1);
-      const double mu = (1.0 - sigma) * chi(detmin, k.eps);
-      k.eps = detmin < mu ? 2.0 * std::sqrt(mu * (mu - detmin)) : 1e-10;
+      if (detmin <= 0 && params.stall_rounds > 0) {
+        // Stalled: the count of hexes with a non-positive term has not dropped for stall_rounds.
+        prob.hex_min_value(hex_s);
+        const int32_t bad = static_cast<int32_t>(
+            std::count_if(hex_s.begin(), hex_s.end(), [](double v) { return v <= 0.0; }));
+        if (bad < best_bad) best_bad = bad, best_round = round;
+        else if (round - best_round >= params.stall_rounds) break;
+      }
+      if (params.eps_rule == EpsRule::tracking) {
+        if ((round + 1) % 10 == 0 && eps_floor > 1e-8) eps_floor *= 0.5;
+        k.eps = tracking_eps();
+      } else {
+        const double sigma = std::max(1.0 - e / e_prev, 0.1);
+        const double mu = (1.0 - sigma) * chi(detmin, k.eps);
+        k.eps = detmin < mu ? 2.0 * std::sqrt(mu * (mu - detmin)) : 1e-10;
+      }
     }
     res.stats.final_eps = k.eps;
     res.stats.untangle.evaluations = prob.evaluations - ev0;

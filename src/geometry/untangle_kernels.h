@@ -54,13 +54,22 @@ inline double inv_cbrt(double x) {
   return y;
 }
 
-/// The active corners of one hex, gathered for the batched kernels: edge vectors e_k, the
-/// cofactors d_k = d det / d e_k and det, compacted to n entries.
+/// Index of the centre term in a hex mask: bit kCentre stands for the Jacobian at the hex centre.
+inline constexpr int kCentre = 8;
+/// Entries per hex: the 8 corner tetrahedra and the centre.
+inline constexpr int kHexTerms = 9;
+
+/// The active terms of one hex, gathered for the batched kernels: edge vectors e_k, the
+/// cofactors d_k = d det / d e_k and det, compacted to n entries. Terms 0..7 are the corner
+/// tetrahedra; term 8 (kCentre) is the Jacobian at the centre, the one Verdict's scaled Jacobian
+/// adds to the 8 corners: e_k = a quarter of principal axis k (the sum of the 4 hex edges in
+/// direction k), so a unit cube gives e_k = unit vectors as at its corners. Without it a hex can
+/// have 8 positive corners and still be inverted as a whole (measured on screw2: 144 such hexes).
 struct HexCorners {
   int n = 0;
-  int corner[8];       ///< local corner index of entry i
-  Vec3 e[8][3], d[8][3];
-  double det[8];
+  int corner[kHexTerms];  ///< term index (corner 0..7 or kCentre) of entry i
+  Vec3 e[kHexTerms][3], d[kHexTerms][3];
+  double det[kHexTerms];
   void load(const Vec3 (&p)[8], unsigned mask) {
     n = 0;
     for (int c = 0; c < 8; ++c) {
@@ -68,18 +77,42 @@ struct HexCorners {
       const auto& fr = kHexCornerFrames[c];
       Vec3* ei = e[n];
       ei[0] = p[fr[0]] - p[c], ei[1] = p[fr[1]] - p[c], ei[2] = p[fr[2]] - p[c];
-      d[n][0] = ei[1].cross(ei[2]), d[n][1] = ei[2].cross(ei[0]), d[n][2] = ei[0].cross(ei[1]);
-      det[n] = ei[0].dot(d[n][0]);
+      set_cofactors(n);
       corner[n++] = c;
     }
+    if (mask >> kCentre & 1u) {
+      Vec3* ei = e[n];
+      ei[0] = 0.25 * ((p[1] - p[0]) + (p[2] - p[3]) + (p[5] - p[4]) + (p[6] - p[7]));
+      ei[1] = 0.25 * ((p[3] - p[0]) + (p[2] - p[1]) + (p[7] - p[4]) + (p[6] - p[5]));
+      ei[2] = 0.25 * ((p[4] - p[0]) + (p[5] - p[1]) + (p[6] - p[2]) + (p[7] - p[3]));
+      set_cofactors(n);
+      corner[n++] = kCentre;
+    }
+  }
+  void set_cofactors(int i) {
+    d[i][0] = e[i][1].cross(e[i][2]), d[i][1] = e[i][2].cross(e[i][0]), d[i][2] = e[i][0].cross(e[i][1]);
+    det[i] = e[i][0].dot(d[i][0]);
   }
   double tr(int i) const { return e[i][0].squaredNorm() + e[i][1].squaredNorm() + e[i][2].squaredNorm(); }
-  /// Adds the gradient a_k e_k + b d_k of entry i (k = 0, 1, 2) to the corner's 4 points.
+  /// Adds the gradient a_k e_k + b d_k of entry i (k = 0, 1, 2) to the term's points.
   void scatter(int i, double a0, double a1, double a2, double b, Vec3 (&g)[8]) const {
     const int c = corner[i];
-    const auto& fr = kHexCornerFrames[c];
     const Vec3 g0 = a0 * e[i][0] + b * d[i][0], g1 = a1 * e[i][1] + b * d[i][1],
                g2 = a2 * e[i][2] + b * d[i][2];
+    if (c == kCentre) {
+      // d e_k / d p_j = +-1/4: + for the points on the far side in direction k.
+      const Vec3 q0 = 0.25 * g0, q1 = 0.25 * g1, q2 = 0.25 * g2;
+      g[0] -= q0 + q1 + q2;
+      g[1] += q0 - q1 - q2;
+      g[2] += q0 + q1 - q2;
+      g[3] += -q0 + q1 - q2;
+      g[4] += -q0 - q1 + q2;
+      g[5] += q0 - q1 + q2;
+      g[6] += q0 + q1 + q2;
+      g[7] += -q0 + q1 + q2;
+      return;
+    }
+    const auto& fr = kHexCornerFrames[c];
     g[fr[0]] += g0;
     g[fr[1]] += g1;
     g[fr[2]] += g2;
@@ -138,7 +171,7 @@ struct WinslowKernel {
   double hex(const Vec3 (&p)[8], unsigned mask, Vec3 (&g)[8], double& vmin) const {
     HexCorners hc;
     hc.load(p, mask);
-    double inv_c[8], inv_r[8], c23[8];
+    double inv_c[kHexTerms], inv_r[kHexTerms], c23[kHexTerms];
     for (int i = 0; i < hc.n; ++i) reciprocals(hc.det[i], inv_c[i], inv_r[i]);
     for (int i = 0; i < hc.n; ++i) c23[i] = inv_c[i] * inv_cbrt(inv_c[i]);
     double f = 0.0;
@@ -257,7 +290,7 @@ struct QualityKernel {
   double hex(const Vec3 (&p)[8], unsigned mask, Vec3 (&g)[8], double& vmin) const {
     HexCorners hc;
     hc.load(p, mask);
-    double a2[8], b2[8], c2[8], inv_pr[8], inv_l[8], s[8];
+    double a2[kHexTerms], b2[kHexTerms], c2[kHexTerms], inv_pr[kHexTerms], inv_l[kHexTerms], s[kHexTerms];
     bool bad = false;
     for (int i = 0; i < hc.n; ++i) {
       a2[i] = hc.e[i][0].squaredNorm(), b2[i] = hc.e[i][1].squaredNorm(), c2[i] = hc.e[i][2].squaredNorm();
@@ -273,7 +306,7 @@ struct QualityKernel {
       bad |= !(l > 1e-300) || s[i] <= floor;
     }
     if (bad) return std::numeric_limits<double>::infinity();
-    double inv_c[8], inv_r[8], c23[8], ex[8];
+    double inv_c[kHexTerms], inv_r[kHexTerms], c23[kHexTerms], ex[kHexTerms];
     for (int i = 0; i < hc.n; ++i) winslow.reciprocals(hc.det[i], inv_c[i], inv_r[i]);
     for (int i = 0; i < hc.n; ++i) c23[i] = inv_c[i] * inv_cbrt(inv_c[i]);
     for (int i = 0; i < hc.n; ++i) ex[i] = std::exp(beta * (s_ref - s[i]));

@@ -154,6 +154,63 @@ TEST(GeometryUntangle, HexKernelsMatchCornerKernels) {
   }
 }
 
+// The centre term (Verdict's ninth Jacobian): its gradient matches central differences of the
+// energy in both kernels, and the quality kernel's minimum over all nine terms is Verdict's hex
+// scaled Jacobian (quality.h), also on hexes whose corners are all positive and whose centre is not.
+TEST(GeometryUntangle, CentreTermGradientAndVerdictMinimum) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> uni(-1.0, 1.0);
+  const Vec3 cube[8] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
+                        {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+  const unsigned centre = 1u << untangle_detail::kCentre, all = centre | 0xffu;
+  int centre_only_negative = 0;
+  // 200 moderately jittered hexes for the gradients, then a search through strongly jittered
+  // ones (about 1 in 10^4 has 8 positive corners and a negative centre) for the minimum.
+  for (int trial = 0; trial < 200000; ++trial) {
+    const bool gradients = trial < 200;
+    Vec3 p[8];
+    for (int k = 0; k < 8; ++k)
+      p[k] = cube[k] + (gradients ? 0.45 : 1.0) * Vec3(uni(rng), uni(rng), uni(rng));
+    untangle_detail::WinslowKernel w{0.3, 1.0};
+    untangle_detail::QualityKernel q{30.0, 0.2, -std::numeric_limits<double>::infinity(), 0.1,
+                                     untangle_detail::WinslowKernel{0.3, 1.0}};
+    auto check_gradient = [&](const auto& kernel) {
+      Vec3 g[8];
+      for (auto& v : g) v.setZero();
+      double m = std::numeric_limits<double>::infinity();
+      const double f = kernel.hex(p, centre, g, m);
+      if (!std::isfinite(f)) return;
+      for (int k = 0; k < 8; ++k)
+        for (int d = 0; d < 3; ++d) {
+          const double h = 1e-6;
+          Vec3 pp[8], pm[8], dummy[8];
+          for (int i = 0; i < 8; ++i) pp[i] = pm[i] = p[i];
+          pp[k][d] += h, pm[k][d] -= h;
+          double m1 = m, m2 = m;
+          const double fd = (kernel.hex(pp, centre, dummy, m1) - kernel.hex(pm, centre, dummy, m2)) / (2 * h);
+          EXPECT_NEAR(g[k][d], fd, 1e-5 * (1.0 + std::abs(fd))) << "point " << k << " axis " << d;
+        }
+    };
+    if (gradients) {
+      SCOPED_TRACE("trial " + std::to_string(trial));
+      check_gradient(w);
+      check_gradient(q);
+    }
+    Vec3 g[8];
+    for (auto& v : g) v.setZero();
+    double s_all = std::numeric_limits<double>::infinity(), s_corners = s_all;
+    q.hex(p, all, g, s_all);
+    q.hex(p, 0xffu, g, s_corners);
+    std::array<Vec3, 8> corners;
+    for (int k = 0; k < 8; ++k) corners[k] = p[k];
+    if (gradients || (s_corners > 0 && s_all <= 0)) {
+      ASSERT_NEAR(s_all, scaled_jacobian(corners), 1e-12) << "trial " << trial;
+      if (s_corners > 0 && s_all <= 0) ++centre_only_negative;
+    }
+  }
+  EXPECT_GT(centre_only_negative, 0) << "no trial had positive corners and a negative centre";
+}
+
 TEST(GeometryUntangle, JitteredGridBecomesPositiveAndBoundaryStays) {
   for (uint64_t seed : {1u, 2u, 3u})
   for (UntangleSolver solver : {UntangleSolver::newton, UntangleSolver::lbfgs}) {
