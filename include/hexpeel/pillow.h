@@ -84,6 +84,11 @@ std::vector<ForcedConfiguration> find_forced_configurations(const QuadSurface& s
                                                             const HexComplex& complex,
                                                             double forced_sj = 0.2);
 
+/// Whether some unit direction d has d . n < -margin for every unit normal n (an empty list has
+/// one, vacuously). Exact for any number of normals; the pillow leaves out boundary vertices without one,
+/// since their copy could not sit strictly inside every quad corner there.
+bool has_inward_direction(const std::vector<Vec3>& unit_normals, double margin);
+
 /// Detects forced configurations and pillows as `params.mode` says. The result's boundary is the
 /// input surface, vertex for vertex (copies are new interior vertices, input_vertex = -1), and the
 /// complex stays a ball (checked; a pillow that breaks it is not applied).

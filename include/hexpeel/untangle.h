@@ -47,6 +47,8 @@ enum class EpsRule : uint8_t {
   tracking,
 };
 
+std::string_view to_string(EpsRule r);
+
 struct UntangleParams {
   bool untangle = true;   ///< run phase 1 (Winslow energy with epsilon continuation)
   bool optimize = true;   ///< run phase 2 (smoothed-min scaled Jacobian)
@@ -116,6 +118,8 @@ struct UntanglePhaseStats {
 
 struct UntangleStats {
   UntangleSolver solver = UntangleSolver::lbfgs;  ///< phase 1 minimizer used
+  EpsRule eps_rule = EpsRule::tracking;           ///< phase 1 eps schedule used
+  bool stalled = false;  ///< phase 1 stopped because the inverted count stopped dropping
   int32_t free_vertices = 0;
   int32_t active_corners = 0;   ///< corner tetrahedra in the energy (some point free)
   int32_t forced_corners = 0;   ///< left out: all 4 points fixed, or the fixed ones collinear

@@ -44,6 +44,38 @@ std::string_view to_string(ForcedKind k) {
   return "?";
 }
 
+/// The direction maximizing min_i (-d . n_i) over unit d is the centre of the smallest spherical
+/// cap holding every -n_i, and that cap is fixed by at most 3 of them: it is -n_i, the bisector of
+/// some -n_i, -n_j, or a point equidistant from some three. Trying all of those (valences are
+/// small) makes the test exact, where the mean normal alone misses skewed stars.
+bool has_inward_direction(const std::vector<Vec3>& unit_normals, double margin) {
+  const auto& ns = unit_normals;
+  if (ns.empty()) return true;
+  auto inward = [&](Vec3 d) {
+    const double l = d.norm();
+    if (!(l > 1e-12)) return false;
+    d /= l;
+    for (const Vec3& n : ns)
+      if (d.dot(n) > -margin) return false;
+    return true;
+  };
+  Vec3 mean = Vec3::Zero();
+  for (const Vec3& n : ns) mean += n;
+  if (inward(-mean)) return true;
+  const size_t m = ns.size();
+  for (size_t i = 0; i < m; ++i) {
+    if (inward(-ns[i])) return true;
+    for (size_t j = i + 1; j < m; ++j) {
+      if (inward(-(ns[i] + ns[j]))) return true;
+      for (size_t k = j + 1; k < m; ++k) {
+        const Vec3 c = (ns[j] - ns[i]).cross(ns[k] - ns[i]);  // equidistant from the three
+        if (inward(c) || inward(-c)) return true;
+      }
+    }
+  }
+  return false;
+}
+
 namespace {
 
 using FaceKey = std::array<int32_t, 4>;
@@ -71,8 +103,7 @@ std::vector<int32_t> face_neighbours(const std::vector<Hex>& hexes) {
 }
 
 /// Boundary vertices (complex ids) whose surface quads admit no strictly inward direction d
-/// (d . n < 0 for every quad normal n at the vertex). Candidate directions: minus the mean
-/// normal, minus each normal, minus each pair's sum; a vertex passing none is excluded.
+/// (d . n < -1e-3 for every unit quad-corner normal n at the vertex): see has_inward_direction.
 std::vector<uint8_t> no_inward_direction(const QuadSurface& surface, const HexComplex& complex) {
   std::vector<std::vector<Vec3>> normals(surface.num_points());
   for (const Quad& q : surface.quads)
@@ -83,24 +114,8 @@ std::vector<uint8_t> no_inward_direction(const QuadSurface& surface, const HexCo
       if (l > 0) normals[q[k]].push_back(n / l);
     }
   std::vector<uint8_t> bad_input(surface.num_points(), 0);
-  for (int32_t v = 0; v < surface.num_points(); ++v) {
-    const auto& ns = normals[v];
-    if (ns.empty()) continue;
-    auto inward = [&](Vec3 d) {
-      const double l = d.norm();
-      if (!(l > 1e-12)) return false;
-      d /= l;
-      for (const Vec3& n : ns)
-        if (d.dot(n) > -1e-3) return false;
-      return true;
-    };
-    bool ok = inward(-std::accumulate(ns.begin(), ns.end(), Vec3(Vec3::Zero())));
-    for (size_t i = 0; !ok && i < ns.size(); ++i) {
-      ok = inward(-ns[i]);
-      for (size_t j = i + 1; !ok && j < ns.size(); ++j) ok = inward(-(ns[i] + ns[j]));
-    }
-    bad_input[v] = !ok;
-  }
+  for (int32_t v = 0; v < surface.num_points(); ++v)
+    bad_input[v] = !normals[v].empty() && !has_inward_direction(normals[v], 1e-3);
   std::vector<uint8_t> bad(complex.num_vertices, 0);
   for (int32_t v = 0; v < complex.num_vertices; ++v)
     if (complex.input_vertex[v] >= 0) bad[v] = bad_input[complex.input_vertex[v]];

@@ -58,6 +58,10 @@ std::string_view to_string(UntangleSolver s) {
   return s == UntangleSolver::newton ? "newton" : "lbfgs";
 }
 
+std::string_view to_string(EpsRule r) {
+  return r == EpsRule::theorem ? "theorem" : "tracking";
+}
+
 bool parse_untangle_solver(std::string_view name, UntangleSolver& out) {
   if (name == "newton") out = UntangleSolver::newton;
   else if (name == "lbfgs") out = UntangleSolver::lbfgs;
@@ -570,6 +574,7 @@ UntangleResult run_untangle(const HexMesh& mesh, const std::vector<uint8_t>& fix
   build_problem(prob, mesh.hexes, fixed, params.collinear_tol, &forced, &forced_nonpositive);
   const int32_t nu = static_cast<int32_t>(prob.free_point.size()), nc = prob.num_corners();
   res.stats.solver = params.solver;
+  res.stats.eps_rule = params.eps_rule;
   res.stats.free_vertices = nu;
   res.stats.forced_corners = forced;
   res.stats.forced_nonpositive = forced_nonpositive;
@@ -631,7 +636,10 @@ UntangleResult run_untangle(const HexMesh& mesh, const std::vector<uint8_t>& fix
         const int32_t bad = static_cast<int32_t>(
             std::count_if(hex_s.begin(), hex_s.end(), [](double v) { return v <= 0.0; }));
         if (bad < best_bad) best_bad = bad, best_round = round;
-        else if (round - best_round >= params.stall_rounds) break;
+        else if (round - best_round >= params.stall_rounds) {
+          res.stats.stalled = true;
+          break;
+        }
       }
       if (params.eps_rule == EpsRule::tracking) {
         if ((round + 1) % 10 == 0 && eps_floor > 1e-8) eps_floor *= 0.5;

@@ -225,6 +225,8 @@ nlohmann::json to_json(const MeshResult& r) {
                      {"active_corners", u.active_corners},
                      {"forced_corners", u.forced_corners},
                      {"forced_nonpositive", u.forced_nonpositive},
+                     {"eps_rule", std::string(to_string(u.eps_rule))},
+                     {"stalled", u.stalled},
                      {"final_eps", u.final_eps},
                      {"untangle", phase(u.untangle)},
                      {"optimize", phase(u.optimize)},

@@ -333,6 +333,43 @@ Generated flat_doublet() {
   return g;
 }
 
+// Exact inward-direction test: a convex corner has one, a saddle with opposite normals has none,
+// and a star whose best direction is fixed by three normals (the mean, each normal and each pair
+// fail) has one.
+TEST(GeometryPillow, InwardDirectionIsExact) {
+  EXPECT_TRUE(has_inward_direction({Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)}, 1e-3));
+  EXPECT_FALSE(has_inward_direction({Vec3(1, 0, 0), Vec3(-1, 0, 0), Vec3(0, 0, 1)}, 1e-3));
+  // -n at colatitude 80 deg, azimuths 0, 120, 240 (the cap centre is the pole, 80 deg away), plus
+  // five more inside the cap near the first, which drag the mean away from the pole.
+  auto minus_at = [](double colat_deg, double az_deg) {
+    const double t = colat_deg * M_PI / 180.0, a = az_deg * M_PI / 180.0;
+    return Vec3(-std::sin(t) * std::cos(a), -std::sin(t) * std::sin(a), -std::cos(t));
+  };
+  std::vector<Vec3> ns{minus_at(80, 0), minus_at(80, 120), minus_at(80, 240)};
+  for (int k = 0; k < 5; ++k) ns.push_back(minus_at(70 + 2 * k, -10 + 5 * k));
+  // Every 1- and 2-point candidate misses some normal:
+  auto strictly_inward = [&](Vec3 d) {
+    d.normalize();
+    for (const Vec3& n : ns)
+      if (d.dot(n) > -1e-3) return false;
+    return true;
+  };
+  Vec3 mean = Vec3::Zero();
+  for (const Vec3& n : ns) mean += n;
+  EXPECT_FALSE(strictly_inward(-mean));
+  for (size_t i = 0; i < ns.size(); ++i) {
+    EXPECT_FALSE(strictly_inward(-ns[i]));
+    for (size_t j = i + 1; j < ns.size(); ++j) EXPECT_FALSE(strictly_inward(-(ns[i] + ns[j])));
+  }
+  EXPECT_TRUE(strictly_inward(Vec3(0, 0, 1)));
+  EXPECT_TRUE(has_inward_direction(ns, 1e-3));
+  // Widening the cap past a hemisphere removes the direction.
+  ns.push_back(minus_at(100, 60));
+  ns.push_back(minus_at(100, 180));
+  ns.push_back(minus_at(100, 300));
+  EXPECT_FALSE(has_inward_direction(ns, 1e-3));
+}
+
 TEST(GeometryPillow, FlatDoubletIsDetected) {
   Generated g = flat_doublet();
   std::vector<ForcedConfiguration> f = find_forced_configurations(g.surface, complex_of(g));
