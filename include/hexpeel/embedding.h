@@ -32,6 +32,13 @@ struct PlacementResult {
   PlacementStats stats;
 };
 
+/// Harmonic (uniform graph Laplacian over the hex edges) positions for the vertices with
+/// fixed[v] == 0, the others held where `points` has them; conjugate gradients to `tolerance`
+/// (relative residual), the three coordinates solved in parallel (deterministic). Used by the
+/// placement and by the untangler's boundary continuation (untangle.h).
+Status harmonic_fill(const std::vector<Hex>& hexes, const std::vector<uint8_t>& fixed,
+                     double tolerance, std::vector<Vec3>& points);
+
 PlacementResult run_placement(const QuadSurface& surface, const HexComplex& complex,
                               const PlacementParams& params = {}, const Context& ctx = {});
 

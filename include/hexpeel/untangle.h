@@ -35,7 +35,8 @@ std::string_view to_string(UntangleSolver s);
 /// "newton" or "lbfgs"; false (and `out` untouched) for anything else.
 bool parse_untangle_solver(std::string_view name, UntangleSolver& out);
 
-/// How phase 1 lowers eps between rounds (det below is the min corner det, in units of the
+/// How phase 1 lowers eps between rounds (det below is the min det over the corner and centre
+/// terms, in units of the
 /// reference cube).
 enum class EpsRule : uint8_t {
   /// Garanzha et al. 2021, section 4: eps shrinks by a factor tied to the energy decrease, which
@@ -57,7 +58,7 @@ struct UntangleParams {
   double lambda = 1.0;
   /// Phase 1 minimizer. L-BFGS is the default: on every mesh measured (issue 6) it was faster than
   /// Newton, whose CHOLMOD factorizations of a 3D mesh's Hessian fill in heavily, and reached the
-  /// same result (screw2 stays inverted with both).
+  /// same result.
   UntangleSolver solver = UntangleSolver::lbfgs;
   /// Phase 1 eps schedule. tracking: screw2 (4869 hexes) untangles in 39 rounds, where theorem
   /// keeps 358 hexes inverted after 20 rounds and 63 after 300 (issue 6).
@@ -66,11 +67,18 @@ struct UntangleParams {
   /// Phase 1 also stops when the number of hexes with a non-positive corner or centre has not
   /// dropped for this many rounds (0: run all max_outer rounds while any is inverted).
   int stall_rounds = 20;
+  /// When hexes stay inverted, retry by boundary continuation: untangle inside a smoothed copy
+  /// of the boundary (morph_smoothing Laplacian steps of 1/2 over the boundary edges), then move
+  /// the boundary back in morph_stages steps, untangling after each; the better of the two
+  /// results is kept. 0 disables it. screw2 with --improve-budget 0: 169 hexes inverted
+  /// directly, 0 by continuation (issue 6).
+  int morph_stages = 10;
+  int morph_smoothing = 100;      ///< boundary smoothing steps of the continuation (0..100000)
   int max_inner = 200;            ///< L-BFGS iterations per round, both phases (1..100000)
   double inner_gtol = 1e-5;       ///< L-BFGS gradient tolerance, relative to |x| (> 0)
-  double energy_rtol = 1e-5;      ///< phase 1 stops once all corners are positive and E changes by less
+  double energy_rtol = 1e-5;      ///< phase 1 stops once all terms are positive and E changes by less
   /// Phase 1 stopping rule. false (default): when phase 2 runs, stop after the first round that
-  /// leaves every corner positive; phase 2, whose objective includes the Winslow energy at
+  /// leaves every term (corner, centre) positive; phase 2, whose objective includes the Winslow energy at
   /// eps ~ 0, does the rest of the relaxation. true (and always when optimize is false): keep
   /// lowering eps until E changes by less than energy_rtol (the papers' rule). On a 10k-hex
   /// jittered sphere that took 12 rounds and 9x the evaluations where the first round already
@@ -83,8 +91,8 @@ struct UntangleParams {
   /// CHOLMOD factorization: supernodal (BLAS blocks) or simplicial (no BLAS). Same result up to
   /// rounding; the choice only matters for speed.
   bool supernodal = true;
-  /// Phase 2 minimizes sum exp(beta * (s_min - s)) over the corner scaled Jacobians s: larger beta
-  /// focuses harder on the worst corners (dimensionless, 1..200).
+  /// Phase 2 minimizes sum exp(beta * (s_min - s)) over the 9 scaled Jacobians s of every hex
+  /// (8 corners and the centre): larger beta focuses harder on the worst ones (dimensionless, 1..200).
   double beta = 30.0;
   /// Phase 2 adds this times the phase 1 energy (eps ~ 0), which keeps edges from collapsing
   /// (the scaled Jacobian alone does not see size). Dimensionless, >= 0.
@@ -108,7 +116,7 @@ struct UntanglePhaseStats {
   int32_t rounds = 0;        ///< outer rounds (epsilon updates / phase 2 restarts)
   int32_t iterations = 0;    ///< L-BFGS iterations, summed over rounds
   int32_t evaluations = 0;   ///< energy + gradient evaluations (of the whole mesh or a region)
-  int64_t corner_evaluations = 0;  ///< corner terms evaluated, summed over evaluations
+  int64_t corner_evaluations = 0;  ///< corner and centre terms evaluated, summed over evaluations
   int32_t factorizations = 0;  ///< Newton: numeric Cholesky factorizations (0 for L-BFGS)
   double solve_time_s = 0.0;   ///< Newton: Hessian assembly + factorization + solves
   double time_s = 0.0;
@@ -120,6 +128,10 @@ struct UntangleStats {
   UntangleSolver solver = UntangleSolver::lbfgs;  ///< phase 1 minimizer used
   EpsRule eps_rule = EpsRule::tracking;           ///< phase 1 eps schedule used
   bool stalled = false;  ///< phase 1 stopped because the inverted count stopped dropping
+  bool continuation_run = false;   ///< the direct run left hexes inverted: continuation tried
+  bool continuation_used = false;  ///< ... and its result was better, so it is the one returned
+  int32_t direct_nonpositive = -1; ///< hexes <= 0 after the direct run (when continuation ran)
+  int32_t direct_rounds = 0;       ///< phase 1 rounds of the direct run (when continuation ran)
   int32_t free_vertices = 0;
   int32_t active_corners = 0;   ///< corner tetrahedra in the energy (some point free)
   int32_t forced_corners = 0;   ///< left out: all 4 points fixed, or the fixed ones collinear

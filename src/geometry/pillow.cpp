@@ -21,7 +21,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <numeric>
 
 namespace hexpeel {
 

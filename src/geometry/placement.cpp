@@ -38,6 +38,66 @@ std::vector<std::pair<int32_t, int32_t>> coincident_pairs(const std::vector<Vec3
 
 }  // namespace
 
+Status harmonic_fill(const std::vector<Hex>& hexes, const std::vector<uint8_t>& fixed,
+                     double tolerance, std::vector<Vec3>& points) {
+  const int32_t nv = static_cast<int32_t>(points.size());
+  std::vector<int32_t> unknown(nv, -1);
+  int32_t nu = 0;
+  for (int32_t v = 0; v < nv; ++v)
+    if (!fixed[v]) unknown[v] = nu++;
+  if (nu == 0) return Status::success();
+  std::vector<uint64_t> edges;
+  edges.reserve(12 * hexes.size());
+  for (const Hex& h : hexes)
+    for (const auto& e : kHexEdges) {
+      int32_t a = h[e[0]], b = h[e[1]];
+      if (a > b) std::swap(a, b);
+      edges.push_back((static_cast<uint64_t>(a) << 32) | static_cast<uint32_t>(b));
+    }
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  std::vector<Eigen::Triplet<double>> trip;
+  Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(nu, 3);
+  std::vector<double> deg(nu, 0.0);
+  for (uint64_t e : edges) {
+    int32_t a = static_cast<int32_t>(e >> 32), b = static_cast<int32_t>(e & 0xffffffffu);
+    for (auto [x, y] : {std::pair{a, b}, std::pair{b, a}}) {
+      if (unknown[x] < 0) continue;
+      deg[unknown[x]] += 1.0;
+      if (unknown[y] >= 0)
+        trip.emplace_back(unknown[x], unknown[y], -1.0);
+      else
+        rhs.row(unknown[x]) += points[y].transpose();
+    }
+  }
+  for (int32_t i = 0; i < nu; ++i) {
+    if (deg[i] == 0.0)
+      return Status::error(StatusCode::internal_error, "placement: a free vertex has no edge");
+    trip.emplace_back(i, i, deg[i]);
+  }
+  Eigen::SparseMatrix<double> L(nu, nu);
+  L.setFromTriplets(trip.begin(), trip.end());
+  // Conjugate gradients (diagonal preconditioner): a direct factorization of a 3D Laplacian
+  // fills in badly (minutes and gigabytes at 100k hexes); CG needs only the matrix. The three
+  // coordinates are independent solves, one solver each, run in parallel: each is single
+  // threaded, hence deterministic.
+  Eigen::MatrixXd x(nu, 3);
+  std::array<bool, 3> converged{};
+  tbb::parallel_for(0, 3, [&](int d) {
+    Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper> solver;
+    solver.setTolerance(tolerance);
+    solver.setMaxIterations(std::max<int32_t>(1000, 10 * nu));
+    solver.compute(L);
+    x.col(d) = solver.solve(rhs.col(d));
+    converged[d] = solver.info() == Eigen::Success;
+  });
+  if (!(converged[0] && converged[1] && converged[2]))
+    return Status::error(StatusCode::internal_error, "placement: the Laplacian solve did not converge");
+  for (int32_t v = 0; v < nv; ++v)
+    if (unknown[v] >= 0) points[v] = x.row(unknown[v]).transpose();
+  return Status::success();
+}
+
 PlacementResult run_placement(const QuadSurface& surface, const HexComplex& complex,
                               const PlacementParams& params, const Context& ctx) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -45,66 +105,18 @@ PlacementResult run_placement(const QuadSurface& surface, const HexComplex& comp
   const int32_t nv = complex.num_vertices;
   res.mesh.hexes = complex.hexes;
   res.mesh.points.assign(nv, Vec3::Zero());
-  // Unknown numbering for interior vertices.
-  std::vector<int32_t> unknown(nv, -1);
-  int32_t nu = 0;
-  for (int32_t v = 0; v < nv; ++v) {
-    if (complex.input_vertex[v] >= 0)
+  std::vector<uint8_t> fixed(nv, 0);
+  for (int32_t v = 0; v < nv; ++v)
+    if (complex.input_vertex[v] >= 0) {
       res.mesh.points[v] = surface.points[complex.input_vertex[v]];
-    else
-      unknown[v] = nu++;
-  }
-  res.stats.interior_vertices = nu;
-  if (nu > 0) {
-    std::vector<uint64_t> edges;
-    edges.reserve(12 * complex.hexes.size());
-    for (const Hex& h : complex.hexes)
-      for (const auto& e : kHexEdges) {
-        int32_t a = h[e[0]], b = h[e[1]];
-        if (a > b) std::swap(a, b);
-        edges.push_back((static_cast<uint64_t>(a) << 32) | static_cast<uint32_t>(b));
-      }
-    std::sort(edges.begin(), edges.end());
-    edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
-    std::vector<Eigen::Triplet<double>> trip;
-    Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(nu, 3);
-    std::vector<double> deg(nu, 0.0);
-    for (uint64_t e : edges) {
-      int32_t a = static_cast<int32_t>(e >> 32), b = static_cast<int32_t>(e & 0xffffffffu);
-      for (auto [x, y] : {std::pair{a, b}, std::pair{b, a}}) {
-        if (unknown[x] < 0) continue;
-        deg[unknown[x]] += 1.0;
-        if (unknown[y] >= 0)
-          trip.emplace_back(unknown[x], unknown[y], -1.0);
-        else
-          rhs.row(unknown[x]) += res.mesh.points[y].transpose();
-      }
+      fixed[v] = 1;
     }
-    for (int32_t i = 0; i < nu; ++i) trip.emplace_back(i, i, deg[i]);
-    Eigen::SparseMatrix<double> L(nu, nu);
-    L.setFromTriplets(trip.begin(), trip.end());
-    // Conjugate gradients (diagonal preconditioner): a direct factorization of a 3D Laplacian
-    // fills in badly (minutes and gigabytes at 100k hexes); CG needs only the matrix. The three
-    // coordinates are independent solves, one solver each, run in parallel: each is single
-    // threaded, hence deterministic.
-    Eigen::MatrixXd x(nu, 3);
-    std::array<bool, 3> converged{};
-    tbb::parallel_for(0, 3, [&](int d) {
-      Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper> solver;
-      solver.setTolerance(params.solver_tolerance);
-      solver.setMaxIterations(std::max<int32_t>(1000, 10 * nu));
-      solver.compute(L);
-      x.col(d) = solver.solve(rhs.col(d));
-      converged[d] = solver.info() == Eigen::Success;
-    });
-    if (!(converged[0] && converged[1] && converged[2])) {
-      res.status = Status::error(StatusCode::internal_error,
-                                 "placement: the Laplacian solve did not converge");
-      return res;
-    }
-    for (int32_t v = 0; v < nv; ++v)
-      if (unknown[v] >= 0) res.mesh.points[v] = x.row(unknown[v]).transpose();
-  }
+  std::vector<int32_t> unknown(nv, -1);  // interior vertices (coincident-pair separation below)
+  for (int32_t v = 0, nu = 0; v < nv; ++v)
+    if (!fixed[v]) unknown[v] = nu++;
+  res.stats.interior_vertices = nv - static_cast<int32_t>(std::count(fixed.begin(), fixed.end(), 1));
+  res.status = harmonic_fill(res.mesh.hexes, fixed, params.solver_tolerance, res.mesh.points);
+  if (!res.status.ok()) return res;
   ctx.report("placement", 1.0);
   // Separate coincident vertices: a harmonic solve can put two interior vertices (or an interior
   // and a boundary one) on the same spot, e.g. at a degenerate hex, and point-merging readers

@@ -15,8 +15,9 @@
 // (UntangleParams::relax_after_untangle) and phase 2 does the remaining relaxation. The inner
 // minimizer is L-BFGS or projected Newton (UntangleParams::solver): the
 // corner Hessians in closed form with negative eigenvalues clamped (untangle_kernels.h),
-// assembled into a sparse matrix over the free vertices (corner terms only: the centre terms'
-// Hessians are left out, which keeps the matrix PSD and its pattern that of the corners), factorized by CHOLMOD (symbolic analysis
+// assembled into a sparse matrix over the free vertices (corner terms only: the centre terms
+// couple body-diagonal point pairs the corner pattern lacks, so their Hessians are left out and
+// Newton is first order where a centre is the binding term), factorized by CHOLMOD (symbolic analysis
 // once per run, numeric factorization per iteration), Armijo backtracking from the full step.
 // Corners whose 4 points are all fixed, or whose fixed points are collinear, cannot change their
 // sign: they are left out of the energy and out of the eps schedule (DESIGN.md "Geometry"),
@@ -37,6 +38,7 @@
 // (NewtonSystem), and CHOLMOD does not see the TBB thread count, so any thread count gives the
 // same bytes.
 #include "hexpeel/untangle.h"
+#include "hexpeel/embedding.h"
 #include "geometry/untangle_kernels.h"
 #include "hexpeel/quality.h"
 
@@ -537,8 +539,11 @@ HexQuality hex_quality(const HexMesh& mesh) {
 
 }  // namespace
 
-UntangleResult run_untangle(const HexMesh& mesh, const std::vector<uint8_t>& fixed,
-                            const UntangleParams& params, const Context& ctx) {
+namespace {
+
+/// Phase 1 and phase 2 from the given positions (run_untangle without the continuation).
+UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fixed,
+                             const UntangleParams& params, const Context& ctx) {
   const auto t_start = Clock::now();
   UntangleResult res;
   res.mesh = mesh;
@@ -579,7 +584,7 @@ UntangleResult run_untangle(const HexMesh& mesh, const std::vector<uint8_t>& fix
   res.stats.forced_corners = forced;
   res.stats.forced_nonpositive = forced_nonpositive;
   res.stats.active_corners = nc;
-  if (nu == 0 || nc == 0) {
+  if (nu == 0 || prob.num_hexes() == 0) {
     res.stats.time_s = seconds_since(t_start);
     res.stats.optimize.min_sj_before = res.stats.optimize.min_sj_after = q0.min;
     res.stats.optimize.nonpositive_before = res.stats.optimize.nonpositive_after = q0.nonpositive;
@@ -610,9 +615,12 @@ UntangleResult run_untangle(const HexMesh& mesh, const std::vector<uint8_t>& fix
     else k.eps = detmin > 0 ? 1e-10 : 1.0;
     NewtonSystem sys;
     if (params.solver == UntangleSolver::newton) sys.build(prob, params.supernodal);
+    // Stall test state: the fewest hexes with a non-positive term seen after a round, the
+    // positions then, the count after the last round and the checked rounds since the best.
     std::vector<double> hex_s;
-    int32_t best_bad = std::numeric_limits<int32_t>::max();
-    int best_round = 0;
+    Eigen::VectorXd x_best;
+    int32_t best_bad = std::numeric_limits<int32_t>::max(), last_bad = -1;
+    int since_best = 0;
     for (int round = 0; round < params.max_outer; ++round) {
       const double e_prev = prob.evaluate(x, g, k);
       if (params.solver == UntangleSolver::newton) {
@@ -630,13 +638,16 @@ UntangleResult run_untangle(const HexMesh& mesh, const std::vector<uint8_t>& fix
       if (detmin > 0 && std::abs(e_prev - e) <= params.energy_rtol * std::abs(e)) break;
       // Untangled: phase 2 (whose objective includes this energy at eps ~ 0) takes over.
       if (detmin > 0 && !params.relax_after_untangle && params.optimize) break;
+      last_bad = -1;
       if (detmin <= 0 && params.stall_rounds > 0) {
         // Stalled: the count of hexes with a non-positive term has not dropped for stall_rounds.
         prob.hex_min_value(hex_s);
-        const int32_t bad = static_cast<int32_t>(
+        last_bad = static_cast<int32_t>(
             std::count_if(hex_s.begin(), hex_s.end(), [](double v) { return v <= 0.0; }));
-        if (bad < best_bad) best_bad = bad, best_round = round;
-        else if (round - best_round >= params.stall_rounds) {
+        if (last_bad < best_bad) {
+          best_bad = last_bad, since_best = 0;
+          x_best = x;
+        } else if (++since_best >= params.stall_rounds) {
           res.stats.stalled = true;
           break;
         }
@@ -649,6 +660,10 @@ UntangleResult run_untangle(const HexMesh& mesh, const std::vector<uint8_t>& fix
         const double mu = (1.0 - sigma) * chi(detmin, k.eps);
         k.eps = detmin < mu ? 2.0 * std::sqrt(mu * (mu - detmin)) : 1e-10;
       }
+    }
+    if (last_bad > best_bad) {  // ended inverted and worse than the best round: go back there
+      x = x_best;
+      prob.evaluate(x, g, k);
     }
     res.stats.final_eps = k.eps;
     res.stats.untangle.evaluations = prob.evaluations - ev0;
@@ -742,6 +757,103 @@ UntangleResult run_untangle(const HexMesh& mesh, const std::vector<uint8_t>& fix
   }
   res.stats.time_s = seconds_since(t_start);
   return res;
+}
+
+/// Boundary continuation (UntangleParams::morph_stages): the fixed vertices on the mesh's
+/// boundary faces are smoothed (uniform Laplacian over the boundary edges, morph_smoothing
+/// steps of 1/2), which fills pockets and holes; the free vertices are placed harmonically
+/// inside that smoother shape and untangled there; then the boundary moves back to its true
+/// position in morph_stages equal steps, phase 1 untangling after each from where the last one
+/// ended. The last step puts every fixed vertex back bit for bit.
+UntangleResult untangle_by_continuation(const HexMesh& mesh, const std::vector<uint8_t>& fixed,
+                                        const UntangleParams& params, const Context& ctx) {
+  const int32_t np = mesh.num_points();
+  std::vector<std::vector<int32_t>> adj(np);
+  {
+    std::vector<std::pair<std::array<int32_t, 4>, std::array<int32_t, 4>>> faces;
+    faces.reserve(6 * mesh.hexes.size());
+    for (const Hex& h : mesh.hexes)
+      for (const auto& f : kHexFaces) {
+        std::array<int32_t, 4> loop{h[f[0]], h[f[1]], h[f[2]], h[f[3]]}, key = loop;
+        std::sort(key.begin(), key.end());
+        faces.push_back({key, loop});
+      }
+    std::sort(faces.begin(), faces.end());
+    for (size_t i = 0; i < faces.size();) {
+      size_t j = i;
+      while (j < faces.size() && faces[j].first == faces[i].first) ++j;
+      if (j - i == 1)  // a boundary face
+        for (int k = 0; k < 4; ++k) {
+          const int32_t a = faces[i].second[k], b = faces[i].second[(k + 1) % 4];
+          if (fixed[a] && fixed[b]) adj[a].push_back(b), adj[b].push_back(a);
+        }
+      i = j;
+    }
+    for (auto& a : adj) {
+      std::sort(a.begin(), a.end());
+      a.erase(std::unique(a.begin(), a.end()), a.end());
+    }
+  }
+  HexMesh m = mesh;
+  std::vector<Vec3> smooth(mesh.points);
+  for (int it = 0; it < params.morph_smoothing; ++it) {
+    std::vector<Vec3> next = smooth;
+    for (int32_t v = 0; v < np; ++v) {
+      if (adj[v].empty()) continue;
+      Vec3 c = Vec3::Zero();
+      for (int32_t w : adj[v]) c += smooth[w];
+      next[v] = 0.5 * (smooth[v] + c / static_cast<double>(adj[v].size()));
+    }
+    smooth.swap(next);
+  }
+  m.points = smooth;
+  UntangleResult r;
+  r.status = harmonic_fill(m.hexes, fixed, 1e-10, m.points);
+  if (!r.status.ok()) return r;
+  UntangleParams p = params;
+  p.optimize = false;
+  r = untangle_once(m, fixed, p, ctx);
+  for (int s = 1; s <= params.morph_stages && r.status.ok(); ++s) {
+    const double t = static_cast<double>(s) / params.morph_stages;
+    m = r.mesh;
+    for (int32_t v = 0; v < np; ++v)
+      if (fixed[v]) m.points[v] = s == params.morph_stages ? mesh.points[v]
+                                                           : Vec3((1.0 - t) * smooth[v] + t * mesh.points[v]);
+    if (s == params.morph_stages) p.optimize = params.optimize;
+    r = untangle_once(m, fixed, p, ctx);
+  }
+  return r;
+}
+
+}  // namespace
+
+UntangleResult run_untangle(const HexMesh& mesh, const std::vector<uint8_t>& fixed,
+                            const UntangleParams& params, const Context& ctx) {
+  const auto t0 = Clock::now();
+  UntangleResult direct = untangle_once(mesh, fixed, params, ctx);
+  if (!direct.status.ok() || !params.untangle || params.morph_stages <= 0 ||
+      direct.stats.untangle.nonpositive_after == 0)
+    return direct;
+  // Hexes stayed inverted: the start may have folded the mesh through the boundary (a harmonic
+  // placement puts interior vertices into pockets of concave shapes), which local minimization
+  // cannot undo. Retry by continuation and keep whichever result is better.
+  ctx.report("untangle", 1.0);
+  UntangleResult cont = untangle_by_continuation(mesh, fixed, params, ctx);
+  const int32_t direct_bad = direct.stats.untangle.nonpositive_after;
+  const int32_t direct_rounds = direct.stats.untangle.rounds;
+  const bool better = cont.status.ok() &&
+                      (cont.stats.untangle.nonpositive_after < direct_bad ||
+                       (cont.stats.untangle.nonpositive_after == direct_bad &&
+                        cont.stats.optimize.min_sj_after > direct.stats.optimize.min_sj_after));
+  UntangleResult& out = better ? cont : direct;
+  out.stats.continuation_run = true;
+  out.stats.continuation_used = better;
+  out.stats.direct_nonpositive = direct_bad;
+  out.stats.direct_rounds = direct_rounds;
+  out.stats.untangle.nonpositive_before = direct.stats.untangle.nonpositive_before;
+  out.stats.untangle.min_sj_before = direct.stats.untangle.min_sj_before;
+  out.stats.time_s = seconds_since(t0);
+  return std::move(out);
 }
 
 }  // namespace hexpeel

@@ -290,6 +290,52 @@ TEST(GeometryUntangle, FocusedOptimizeEvaluatesLessAndKeepsQuality) {
     ASSERT_EQ(a.mesh.points[v], g.known_mesh.points[v]) << "boundary vertex " << v << " moved";
 }
 
+// A boundary corner pushed deep inside (a forced inversion no placement fixes): phase 1 stops on
+// the stall test long before max_outer, returns no more inverted hexes than it started with,
+// the boundary continuation runs (and keeps the better result), and the bytes do not depend on
+// the thread count.
+TEST(GeometryUntangle, ForcedInversionStallsAndStaysDeterministic) {
+  Generated g = testing::cube(3, 3, 3, 1.0);
+  int32_t corner = 0;
+  for (int32_t v = 0; v < g.surface.num_points(); ++v)
+    if (g.known_mesh.points[v].sum() < g.known_mesh.points[corner].sum()) corner = v;
+  g.known_mesh.points[corner] = Vec3(2.6, 2.6, 2.6);
+  const int32_t before = run_quality(g.known_mesh).sj_count_nonpositive;
+  ASSERT_GT(before, 0);
+  UntangleParams p;
+  p.stall_rounds = 5;
+  auto run = [&](int threads) {
+    tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
+    return run_untangle(g.known_mesh, surface_fixed(g), p);
+  };
+  UntangleResult a = run(1), b = run(2);
+  ASSERT_TRUE(a.status.ok()) << to_string(a.status);
+  EXPECT_TRUE(a.stats.continuation_run);
+  EXPECT_GT(a.stats.direct_nonpositive, 0);
+  EXPECT_LT(a.stats.direct_rounds, p.max_outer);
+  EXPECT_LE(a.stats.untangle.nonpositive_after, before);
+  EXPECT_LE(a.stats.untangle.nonpositive_after, a.stats.direct_nonpositive);
+  EXPECT_EQ(run_quality(a.mesh).sj_count_nonpositive, a.stats.optimize.nonpositive_after);
+  ASSERT_EQ(a.mesh.points.size(), b.mesh.points.size());
+  EXPECT_EQ(std::memcmp(a.mesh.points.data(), b.mesh.points.data(), a.mesh.points.size() * sizeof(Vec3)), 0);
+  for (int32_t v = 0; v < g.surface.num_points(); ++v)
+    ASSERT_EQ(std::memcmp(a.mesh.points[v].data(), g.known_mesh.points[v].data(), sizeof(Vec3)), 0);
+}
+
+// The paper's eps rule stays available and untangles a scrambled grid too.
+TEST(GeometryUntangle, TheoremEpsRuleUntangles) {
+  Generated g = testing::jittered(testing::cube(4, 4, 4, 0.25), 2, 0.0);
+  for (int32_t v = g.surface.num_points(); v < g.known_mesh.num_points(); ++v)
+    g.known_mesh.points[v] += Vec3(0.2 * std::sin(3.0 * v), 0.2 * std::cos(5.0 * v), 0.2 * std::sin(7.0 * v));
+  ASSERT_GT(run_quality(g.known_mesh).sj_count_nonpositive, 0);
+  UntangleParams p;
+  p.eps_rule = EpsRule::theorem;
+  UntangleResult r = run_untangle(g.known_mesh, surface_fixed(g), p);
+  EXPECT_EQ(r.stats.eps_rule, EpsRule::theorem);
+  EXPECT_EQ(run_quality(r.mesh).sj_count_nonpositive, 0);
+  EXPECT_FALSE(r.stats.continuation_run);
+}
+
 TEST(GeometryUntangle, SameBytesForAnyThreadCount) {
   Generated g = testing::jittered(testing::cubed_sphere_equiangular(5), 11, 0.3);
   for (UntangleSolver solver : {UntangleSolver::newton, UntangleSolver::lbfgs})
