@@ -71,9 +71,13 @@ struct UntangleParams {
   /// of the boundary (morph_smoothing Laplacian steps of 1/2 over the boundary edges), then move
   /// the boundary back in morph_stages steps, untangling after each; the better of the two
   /// results is kept. 0 disables it. screw2 with --improve-budget 0: 169 hexes inverted
-  /// directly, 0 by continuation (issue 6).
+  /// directly, 0 by continuation; --side-rule heavier: 166 -> 0 (issue 6).
   int morph_stages = 10;
   int morph_smoothing = 100;      ///< boundary smoothing steps of the continuation (0..100000)
+  /// At most this many phase 1 rounds per continuation step: bounds the time spent when the
+  /// continuation cannot help either (screw2 --method original: 190 -> 172 inverted, 754 s with
+  /// 100 rounds a step while CI ran alongside).
+  int morph_step_rounds = 40;
   int max_inner = 200;            ///< L-BFGS iterations per round, both phases (1..100000)
   double inner_gtol = 1e-5;       ///< L-BFGS gradient tolerance, relative to |x| (> 0)
   double energy_rtol = 1e-5;      ///< phase 1 stops once all terms are positive and E changes by less

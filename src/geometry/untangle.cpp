@@ -53,6 +53,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 namespace hexpeel {
 
@@ -764,9 +765,13 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
 /// steps of 1/2), which fills pockets and holes; the free vertices are placed harmonically
 /// inside that smoother shape and untangled there; then the boundary moves back to its true
 /// position in morph_stages equal steps, phase 1 untangling after each from where the last one
-/// ended. The last step puts every fixed vertex back bit for bit.
-UntangleResult untangle_by_continuation(const HexMesh& mesh, const std::vector<uint8_t>& fixed,
-                                        const UntangleParams& params, const Context& ctx) {
+/// ended. The last step puts every fixed vertex back bit for bit. Gives up (nullopt) as soon as a
+/// step leaves more than `give_up_above` hexes inverted: later steps only squeeze harder, and
+/// the direct result is then at least as good (this bounds the time spent on forced cases).
+std::optional<UntangleResult> untangle_by_continuation(const HexMesh& mesh,
+                                                       const std::vector<uint8_t>& fixed,
+                                                       const UntangleParams& params,
+                                                       int32_t give_up_above, const Context& ctx) {
   const int32_t np = mesh.num_points();
   std::vector<std::vector<int32_t>> adj(np);
   {
@@ -807,13 +812,15 @@ UntangleResult untangle_by_continuation(const HexMesh& mesh, const std::vector<u
     smooth.swap(next);
   }
   m.points = smooth;
-  UntangleResult r;
-  r.status = harmonic_fill(m.hexes, fixed, 1e-10, m.points);
-  if (!r.status.ok()) return r;
+  if (!harmonic_fill(m.hexes, fixed, 1e-10, m.points).ok()) return std::nullopt;
   UntangleParams p = params;
   p.optimize = false;
-  r = untangle_once(m, fixed, p, ctx);
-  for (int s = 1; s <= params.morph_stages && r.status.ok(); ++s) {
+  UntangleResult r = untangle_once(m, fixed, p, ctx);
+  // Each step starts close to untangled; a step that needs many rounds is likely a forced case,
+  // so the steps get a shorter round budget (the rescued screw2 plans needed 3-27 per step).
+  p.max_outer = std::min(params.max_outer, params.morph_step_rounds);
+  for (int s = 1; s <= params.morph_stages; ++s) {
+    if (!r.status.ok() || r.stats.untangle.nonpositive_after > give_up_above) return std::nullopt;
     const double t = static_cast<double>(s) / params.morph_stages;
     m = r.mesh;
     for (int32_t v = 0; v < np; ++v)
@@ -822,6 +829,7 @@ UntangleResult untangle_by_continuation(const HexMesh& mesh, const std::vector<u
     if (s == params.morph_stages) p.optimize = params.optimize;
     r = untangle_once(m, fixed, p, ctx);
   }
+  if (!r.status.ok()) return std::nullopt;
   return r;
 }
 
@@ -838,14 +846,16 @@ UntangleResult run_untangle(const HexMesh& mesh, const std::vector<uint8_t>& fix
   // placement puts interior vertices into pockets of concave shapes), which local minimization
   // cannot undo. Retry by continuation and keep whichever result is better.
   ctx.report("untangle", 1.0);
-  UntangleResult cont = untangle_by_continuation(mesh, fixed, params, ctx);
   const int32_t direct_bad = direct.stats.untangle.nonpositive_after;
   const int32_t direct_rounds = direct.stats.untangle.rounds;
-  const bool better = cont.status.ok() &&
-                      (cont.stats.untangle.nonpositive_after < direct_bad ||
-                       (cont.stats.untangle.nonpositive_after == direct_bad &&
-                        cont.stats.optimize.min_sj_after > direct.stats.optimize.min_sj_after));
-  UntangleResult& out = better ? cont : direct;
+  std::optional<UntangleResult> cont =
+      untangle_by_continuation(mesh, fixed, params, direct_bad, ctx);
+  const bool better = cont && (cont->stats.optimize.nonpositive_after <
+                                   direct.stats.optimize.nonpositive_after ||
+                               (cont->stats.optimize.nonpositive_after ==
+                                    direct.stats.optimize.nonpositive_after &&
+                                cont->stats.optimize.min_sj_after > direct.stats.optimize.min_sj_after));
+  UntangleResult& out = better ? *cont : direct;
   out.stats.continuation_run = true;
   out.stats.continuation_used = better;
   out.stats.direct_nonpositive = direct_bad;
