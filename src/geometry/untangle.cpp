@@ -765,9 +765,10 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
 /// steps of 1/2), which fills pockets and holes; the free vertices are placed harmonically
 /// inside that smoother shape and untangled there; then the boundary moves back to its true
 /// position in morph_stages equal steps, phase 1 untangling after each from where the last one
-/// ended. The last step puts every fixed vertex back bit for bit. Gives up (nullopt) as soon as a
-/// step leaves more than `give_up_above` hexes inverted: later steps only squeeze harder, and
-/// the direct result is then at least as good (this bounds the time spent on forced cases).
+/// ended. The last step puts every fixed vertex back bit for bit. Gives up (nullopt) as soon as
+/// the start or a step leaves more hexes inverted than its share of `give_up_above` (the direct
+/// run's count times the fraction of the way done): later steps only squeeze harder, so such a
+/// run rarely beats the direct one, and this bounds the time spent on forced cases.
 std::optional<UntangleResult> untangle_by_continuation(const HexMesh& mesh,
                                                        const std::vector<uint8_t>& fixed,
                                                        const UntangleParams& params,
@@ -820,7 +821,11 @@ std::optional<UntangleResult> untangle_by_continuation(const HexMesh& mesh,
   // so the steps get a shorter round budget (the rescued screw2 plans needed 3-27 per step).
   p.max_outer = std::min(params.max_outer, params.morph_step_rounds);
   for (int s = 1; s <= params.morph_stages; ++s) {
-    if (!r.status.ok() || r.stats.untangle.nonpositive_after > give_up_above) return std::nullopt;
+    // Steps s-1 of morph_stages done: give up once the inverted count exceeds that share of the
+    // direct run's (the successful runs measured stay at 0 all the way).
+    const double share = static_cast<double>(s - 1) / params.morph_stages;
+    if (!r.status.ok() || r.stats.untangle.nonpositive_after > share * give_up_above)
+      return std::nullopt;
     const double t = static_cast<double>(s) / params.morph_stages;
     m = r.mesh;
     for (int32_t v = 0; v < np; ++v)
