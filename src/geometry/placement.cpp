@@ -111,9 +111,6 @@ PlacementResult run_placement(const QuadSurface& surface, const HexComplex& comp
       res.mesh.points[v] = surface.points[complex.input_vertex[v]];
       fixed[v] = 1;
     }
-  std::vector<int32_t> unknown(nv, -1);  // interior vertices (coincident-pair separation below)
-  for (int32_t v = 0, nu = 0; v < nv; ++v)
-    if (!fixed[v]) unknown[v] = nu++;
   res.stats.interior_vertices = nv - static_cast<int32_t>(std::count(fixed.begin(), fixed.end(), 1));
   res.status = harmonic_fill(res.mesh.hexes, fixed, params.solver_tolerance, res.mesh.points);
   if (!res.status.ok()) return res;
@@ -132,8 +129,8 @@ PlacementResult run_placement(const QuadSurface& surface, const HexComplex& comp
     if (pairs.empty()) break;
     std::vector<uint8_t> move(nv, 0);
     for (auto [a, b] : pairs) {
-      if (unknown[a] >= 0) move[a] = 1;
-      if (unknown[b] >= 0) move[b] = 1;
+      if (!fixed[a]) move[a] = 1;
+      if (!fixed[b]) move[b] = 1;
     }
     std::vector<Vec3> target(nv, Vec3::Zero());
     std::vector<int32_t> count(nv, 0);

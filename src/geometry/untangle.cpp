@@ -39,6 +39,7 @@
 // same bytes.
 #include "hexpeel/untangle.h"
 #include "hexpeel/embedding.h"
+#include "quality/quality_internal.h"
 #include "geometry/untangle_kernels.h"
 #include "hexpeel/quality.h"
 
@@ -775,30 +776,14 @@ std::optional<UntangleResult> untangle_by_continuation(const HexMesh& mesh,
                                                        int32_t give_up_above, const Context& ctx) {
   const int32_t np = mesh.num_points();
   std::vector<std::vector<int32_t>> adj(np);
-  {
-    std::vector<std::pair<std::array<int32_t, 4>, std::array<int32_t, 4>>> faces;
-    faces.reserve(6 * mesh.hexes.size());
-    for (const Hex& h : mesh.hexes)
-      for (const auto& f : kHexFaces) {
-        std::array<int32_t, 4> loop{h[f[0]], h[f[1]], h[f[2]], h[f[3]]}, key = loop;
-        std::sort(key.begin(), key.end());
-        faces.push_back({key, loop});
-      }
-    std::sort(faces.begin(), faces.end());
-    for (size_t i = 0; i < faces.size();) {
-      size_t j = i;
-      while (j < faces.size() && faces[j].first == faces[i].first) ++j;
-      if (j - i == 1)  // a boundary face
-        for (int k = 0; k < 4; ++k) {
-          const int32_t a = faces[i].second[k], b = faces[i].second[(k + 1) % 4];
-          if (fixed[a] && fixed[b]) adj[a].push_back(b), adj[b].push_back(a);
-        }
-      i = j;
+  for (const Quad& q : quality_detail::analyze_topology(mesh).boundary_quads)  // faces used by one hex
+    for (int k = 0; k < 4; ++k) {
+      const int32_t a = q[k], b = q[(k + 1) % 4];
+      if (fixed[a] && fixed[b]) adj[a].push_back(b), adj[b].push_back(a);
     }
-    for (auto& a : adj) {
-      std::sort(a.begin(), a.end());
-      a.erase(std::unique(a.begin(), a.end()), a.end());
-    }
+  for (auto& a : adj) {
+    std::sort(a.begin(), a.end());
+    a.erase(std::unique(a.begin(), a.end()), a.end());
   }
   HexMesh m = mesh;
   std::vector<Vec3> smooth(mesh.points);
