@@ -57,6 +57,10 @@ struct PillowParams {
   /// on cubed spheres and pillowed grids the whole layer then gives the higher minimum
   /// (csphere_n12 0.77 vs 0.51), while sparse forced corners are better served locally.
   double whole_fraction = 0.25;
+  /// Pillow passes at most (>= 1). A pass after the first pillows, locally, forced hexes the
+  /// previous one had to keep out of S (at a saddle vertex), giving that vertex another copy; it
+  /// is kept only when it lowers the count of forced corners and unserved vertices.
+  int max_passes = 3;
 };
 
 struct PillowStats {
@@ -64,9 +68,13 @@ struct PillowStats {
   int32_t flat_doublets = 0, concave_corners = 0, fixed_corners = 0, collinear = 0;
   int32_t forced_after = 0;         ///< forced configurations left after pillowing
   int32_t excluded_vertices = 0;    ///< boundary vertices with no strictly inward direction
-  int32_t shrink_set = 0;           ///< hexes in the pillowed shrink set (0 = no pillow)
+  int32_t dropped_hexes = 0;        ///< hexes kept out of S so every copy has an inward direction
+  int32_t unserved_vertices = 0;    ///< boundary vertices whose copy still has none (0 unless
+                                    ///< only the unfitted whole set gave a ball)
+  int32_t shrink_set = 0;           ///< hexes in the pillowed shrink sets, summed over passes
   int32_t new_hexes = 0, new_vertices = 0;
   bool whole_boundary = false;      ///< local pillowing could not be used; the whole set was
+  int32_t passes = 0;               ///< pillow passes applied (0 = no pillow)
   double time_s = 0.0;
 };
 
@@ -85,8 +93,8 @@ std::vector<ForcedConfiguration> find_forced_configurations(const QuadSurface& s
                                                             double forced_sj = 0.2);
 
 /// Whether some unit direction d has d . n < -margin for every unit normal n (an empty list has
-/// one, vacuously). Exact for any number of normals; the pillow leaves out boundary vertices without one,
-/// since their copy could not sit strictly inside every quad corner there.
+/// one, vacuously). Exact for any number of normals. The pillow keeps out of S enough hexes at a
+/// boundary vertex that the quads it pillows there have one: the copy must sit inside each.
 bool has_inward_direction(const std::vector<Vec3>& unit_normals, double margin);
 
 /// Detects forced configurations and pillows as `params.mode` says. The result's boundary is the

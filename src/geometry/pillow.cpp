@@ -11,9 +11,11 @@
 // this is checked and a pillow that fails the check is not used.
 //
 // Shrink set: the forced hexes grown by `grow` rings of face neighbours (local), or every hex
-// (whole boundary) when local pillowing cannot be used or leaves more forced corners. Hexes at a
-// boundary vertex whose quads leave no strictly inward direction are kept out of S: no copy of
-// such a vertex can make all its pillow hexes positive.
+// (whole boundary) when local pillowing cannot be used or leaves more forced corners. A boundary
+// vertex's copy must lie strictly inside every surface quad at it that S pillows (each becomes the
+// bottom of a pillow hex at the copy); at a saddle no direction does that for all its quads, so S
+// is fitted to the boundary: hexes at such a vertex leave S until the pillowed quads there have
+// an inward direction (fit_to_boundary), the vertex keeps the rest of its hexes.
 #include "hexpeel/pillow.h"
 #include "quality/quality_internal.h"
 
@@ -21,6 +23,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <tuple>
 
 namespace hexpeel {
 
@@ -101,24 +104,93 @@ std::vector<int32_t> face_neighbours(const std::vector<Hex>& hexes) {
   return nb;
 }
 
-/// Boundary vertices (complex ids) whose surface quads admit no strictly inward direction d
-/// (d . n < -1e-3 for every unit quad-corner normal n at the vertex): see has_inward_direction.
-std::vector<uint8_t> no_inward_direction(const QuadSurface& surface, const HexComplex& complex) {
-  std::vector<std::vector<Vec3>> normals(surface.num_points());
-  for (const Quad& q : surface.quads)
+/// A surface quad's corner at a boundary vertex: the corner's unit normal (surface orientation)
+/// and the hex whose boundary face the quad is.
+struct BoundaryCorner {
+  Vec3 normal;
+  int32_t hex = -1;
+};
+
+/// Per complex vertex, the corners of the surface quads at it (empty for interior vertices), in
+/// surface quad order.
+std::vector<std::vector<BoundaryCorner>> boundary_corners(const QuadSurface& surface,
+                                                          const HexComplex& complex,
+                                                          const std::vector<int32_t>& nb) {
+  std::vector<int32_t> to_complex(surface.num_points(), -1);
+  for (int32_t v = 0; v < complex.num_vertices; ++v)
+    if (complex.input_vertex[v] >= 0) to_complex[complex.input_vertex[v]] = v;
+  std::vector<std::pair<FaceKey, int32_t>> faces;  // boundary faces of the complex -> hex
+  for (int32_t s = 0; s < static_cast<int32_t>(nb.size()); ++s)
+    if (nb[s] < 0) faces.push_back({face_key(complex.hexes[s / 6], s % 6), s / 6});
+  std::sort(faces.begin(), faces.end());
+  std::vector<std::vector<BoundaryCorner>> out(complex.num_vertices);
+  for (const Quad& q : surface.quads) {
+    FaceKey key;
+    for (int i = 0; i < 4; ++i) key[i] = to_complex[q[i]];
+    std::sort(key.begin(), key.end());
+    const auto it = std::lower_bound(faces.begin(), faces.end(), std::make_pair(key, int32_t{-1}));
+    if (key[0] < 0 || it == faces.end() || it->first != key) continue;
     for (int k = 0; k < 4; ++k) {
       const Vec3& p = surface.points[q[k]];
-      Vec3 n = (surface.points[q[(k + 1) % 4]] - p).cross(surface.points[q[(k + 3) % 4]] - p);
+      const Vec3 n = (surface.points[q[(k + 1) % 4]] - p).cross(surface.points[q[(k + 3) % 4]] - p);
       const double l = n.norm();
-      if (l > 0) normals[q[k]].push_back(n / l);
+      if (l > 0) out[to_complex[q[k]]].push_back({n / l, it->second});
     }
-  std::vector<uint8_t> bad_input(surface.num_points(), 0);
-  for (int32_t v = 0; v < surface.num_points(); ++v)
-    bad_input[v] = !normals[v].empty() && !has_inward_direction(normals[v], 1e-3);
-  std::vector<uint8_t> bad(complex.num_vertices, 0);
-  for (int32_t v = 0; v < complex.num_vertices; ++v)
-    if (complex.input_vertex[v] >= 0) bad[v] = bad_input[complex.input_vertex[v]];
-  return bad;
+  }
+  return out;
+}
+
+/// Margin of the inward-direction test (unit normals): a copy must sit at least this far inside.
+constexpr double kInwardMargin = 1e-3;
+
+/// Whether the surface quads at a vertex whose hexes are in S leave a strictly inward direction
+/// for the vertex's copy (every such quad becomes the bottom of a pillow hex at the copy).
+bool copy_can_serve(const std::vector<BoundaryCorner>& corners, const std::vector<uint8_t>& in_s,
+                    std::vector<Vec3>& scratch) {
+  scratch.clear();
+  for (const BoundaryCorner& c : corners)
+    if (in_s[c.hex]) scratch.push_back(c.normal);
+  return has_inward_direction(scratch, kInwardMargin);
+}
+
+/// Boundary vertices that no shrink set holding all their hexes can serve (a saddle, say).
+int32_t count_saddles(const std::vector<std::vector<BoundaryCorner>>& corners, int32_t num_hexes) {
+  const std::vector<uint8_t> all(num_hexes, 1);
+  std::vector<Vec3> scratch;
+  int32_t n = 0;
+  for (const auto& cs : corners) n += !cs.empty() && !copy_can_serve(cs, all, scratch);
+  return n;
+}
+
+/// Drops hexes from S until every boundary vertex's copy can be served (copy_can_serve). At a
+/// vertex that fails, one hex at a time leaves S: a hex that is not forced before one that is, one
+/// whose removal alone makes the rest servable first, then the lowest id. Dropping only removes
+/// normals at other vertices, so one pass over the vertices suffices. Returns the hexes dropped.
+int32_t fit_to_boundary(std::vector<uint8_t>& in_s,
+                        const std::vector<std::vector<BoundaryCorner>>& corners,
+                        const std::vector<uint8_t>& forced) {
+  int32_t dropped = 0;
+  std::vector<Vec3> scratch;
+  for (const std::vector<BoundaryCorner>& cs : corners) {
+    while (!cs.empty() && !copy_can_serve(cs, in_s, scratch)) {
+      int32_t pick = -1;
+      std::tuple<int, int, int32_t> pick_key{};
+      for (const BoundaryCorner& c : cs) {
+        if (!in_s[c.hex]) continue;
+        in_s[c.hex] = 0;
+        const bool fixes = copy_can_serve(cs, in_s, scratch);
+        in_s[c.hex] = 1;
+        const std::tuple<int, int, int32_t> key{forced[c.hex], !fixes, c.hex};
+        if (pick < 0 || key < pick_key) {
+          pick = c.hex;
+          pick_key = key;
+        }
+      }
+      in_s[pick] = 0;  // some hex of cs is in S, or the (empty) rest would be servable
+      ++dropped;
+    }
+  }
+  return dropped;
 }
 
 /// The complex with S (in_s[h] != 0) pillowed.
@@ -211,6 +283,81 @@ std::vector<ForcedConfiguration> find_forced_configurations(const QuadSurface& s
   return out;
 }
 
+namespace {
+
+/// One pillowed shrink set.
+struct PillowPass {
+  HexComplex complex;
+  int32_t set_size = 0, new_hexes = 0, new_vertices = 0, forced_after = 0, dropped = 0;
+  int32_t unserved = 0;  ///< boundary vertices whose copy has no inward direction
+  bool whole = false;
+  int32_t defects() const { return forced_after + unserved; }
+};
+
+/// Pillows `complex` once around `forced` (its forced configurations): the local shrink set when
+/// `local` and it is small enough (any size when not `whole`), else (or when that leaves
+/// defects) the whole set when `whole` and it does better. False when no set gives a ball.
+bool pillow_once(const QuadSurface& surface, const HexComplex& complex,
+                 const std::vector<ForcedConfiguration>& forced, const PillowParams& params,
+                 bool local, bool whole, PillowPass* out) {
+  const int32_t nh = static_cast<int32_t>(complex.hexes.size());
+  const std::vector<int32_t> nb = face_neighbours(complex.hexes);
+  const std::vector<std::vector<BoundaryCorner>> corners = boundary_corners(surface, complex, nb);
+  std::vector<uint8_t> forced_hex(nh, 0);
+  for (const ForcedConfiguration& f : forced) forced_hex[f.hex] = 1;
+
+  // Pillows S after fitting it to the boundary (or as given, fit = false: the last resort).
+  auto attempt = [&](std::vector<uint8_t> in_s, bool whole, bool fit, PillowPass* res) {
+    PillowPass c;
+    c.whole = whole;
+    if (fit) c.dropped = fit_to_boundary(in_s, corners, forced_hex);
+    c.set_size = static_cast<int32_t>(std::count(in_s.begin(), in_s.end(), 1));
+    if (c.set_size == 0) return false;
+    c.complex = pillow_set(complex, in_s, nb, &c.new_hexes, &c.new_vertices);
+    if (!is_ball(c.complex)) return false;
+    c.forced_after =
+        static_cast<int32_t>(find_forced_configurations(surface, c.complex, params.forced_sj).size());
+    std::vector<Vec3> scratch;
+    for (const auto& cs : corners) c.unserved += !cs.empty() && !copy_can_serve(cs, in_s, scratch);
+    *res = std::move(c);
+    return true;
+  };
+
+  bool have = false;
+  if (local) {
+    std::vector<uint8_t> in_s = forced_hex;
+    for (int ring = 0; ring < params.grow; ++ring) {
+      std::vector<uint8_t> next = in_s;
+      for (int32_t s = 0; s < 6 * nh; ++s)
+        if (in_s[s / 6] && nb[s] >= 0) next[nb[s] / 6] = 1;
+      in_s.swap(next);
+    }
+    int32_t touching = 0;  // hexes with a vertex on the boundary
+    for (const Hex& h : complex.hexes)
+      for (int32_t v : h)
+        if (complex.input_vertex[v] >= 0) {
+          ++touching;
+          break;
+        }
+    const int32_t set_size = static_cast<int32_t>(std::count(in_s.begin(), in_s.end(), 1));
+    if (!whole || params.whole_fraction >= 1.0 || set_size < params.whole_fraction * touching)
+      have = attempt(in_s, false, true, out);
+  }
+  if (whole && (!have || out->defects() > 0)) {
+    PillowPass all_set;
+    const std::vector<uint8_t> all(nh, 1);
+    bool ok = attempt(all, true, true, &all_set);
+    if (!ok) ok = attempt(all, true, false, &all_set);
+    if (ok && (!have || all_set.defects() < out->defects())) {
+      *out = std::move(all_set);
+      have = true;
+    }
+  }
+  return have;
+}
+
+}  // namespace
+
 PillowResult run_pillow(const QuadSurface& surface, const HexComplex& complex,
                         const PillowParams& params, const Context& ctx) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -232,75 +379,36 @@ PillowResult run_pillow(const QuadSurface& surface, const HexComplex& complex,
     st.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return res;
   }
-  const int32_t nh = static_cast<int32_t>(complex.hexes.size());
-  const std::vector<int32_t> nb = face_neighbours(complex.hexes);
-  const std::vector<uint8_t> bad = no_inward_direction(surface, complex);
-  st.excluded_vertices = static_cast<int32_t>(std::count(bad.begin(), bad.end(), 1));
-  std::vector<uint8_t> allowed(nh, 1);
-  for (int32_t h = 0; h < nh; ++h)
-    for (int32_t v : complex.hexes[h])
-      if (bad[v]) allowed[h] = 0;
-
-  struct Candidate {
-    HexComplex complex;
-    int32_t set_size = 0, new_hexes = 0, new_vertices = 0, forced_after = 0;
-    bool whole = false;
-  };
-  auto attempt = [&](const std::vector<uint8_t>& in_s, bool whole, Candidate* out) {
-    Candidate c;
-    c.whole = whole;
-    c.set_size = static_cast<int32_t>(std::count(in_s.begin(), in_s.end(), 1));
-    if (c.set_size == 0) return false;
-    c.complex = pillow_set(complex, in_s, nb, &c.new_hexes, &c.new_vertices);
-    if (!is_ball(c.complex)) return false;
-    c.forced_after =
-        static_cast<int32_t>(find_forced_configurations(surface, c.complex, params.forced_sj).size());
-    *out = std::move(c);
-    return true;
-  };
-
-  Candidate best;
-  bool have = false;
-  if (params.mode == PillowMode::automatic) {
-    std::vector<uint8_t> in_s(nh, 0);
-    for (const ForcedConfiguration& f : res.forced)
-      if (allowed[f.hex]) in_s[f.hex] = 1;
-    for (int ring = 0; ring < params.grow; ++ring) {
-      std::vector<uint8_t> next = in_s;
-      for (int32_t s = 0; s < 6 * nh; ++s)
-        if (in_s[s / 6] && nb[s] >= 0 && allowed[nb[s] / 6]) next[nb[s] / 6] = 1;
-      in_s.swap(next);
-    }
-    int32_t touching = 0;  // hexes with a vertex on the boundary
-    for (const Hex& h : complex.hexes)
-      for (int32_t v : h)
-        if (complex.input_vertex[v] >= 0) {
-          ++touching;
-          break;
-        }
-    const int32_t set_size = static_cast<int32_t>(std::count(in_s.begin(), in_s.end(), 1));
-    if (params.whole_fraction >= 1.0 || set_size < params.whole_fraction * touching)
-      have = attempt(in_s, false, &best);
-    ctx.report("pillow", 0.5);
+  {
+    const std::vector<int32_t> nb = face_neighbours(complex.hexes);
+    st.excluded_vertices = count_saddles(boundary_corners(surface, complex, nb),
+                                         static_cast<int32_t>(complex.hexes.size()));
   }
-  if (!have || best.forced_after > 0) {
-    Candidate whole;
-    bool ok = attempt(allowed, true, &whole);
-    if (!ok) ok = attempt(std::vector<uint8_t>(nh, 1), true, &whole);
-    if (ok && (!have || whole.forced_after < best.forced_after)) {
-      best = std::move(whole);
-      have = true;
+  // Later passes: a forced hex that had to stay out of S (at a saddle, its quads and those of
+  // the other pillowed hexes there have no common inward direction) is pillowed again, locally,
+  // with a second copy of the vertex. Each later pass must lower the defects.
+  std::vector<ForcedConfiguration> forced = res.forced;
+  int32_t defects = st.forced;
+  for (int pass = 0; pass < params.max_passes && (pass == 0 || !forced.empty()); ++pass) {
+    PillowPass p;
+    const bool local = params.mode == PillowMode::automatic || pass > 0;
+    if (!pillow_once(surface, res.complex, forced, params, local, pass == 0, &p)) {
+      if (pass == 0) ctx.warn("pillow: no shrink set gave a ball complex; the mesh is not pillowed");
+      break;
     }
-  }
-  if (have) {
-    res.complex = std::move(best.complex);
-    st.shrink_set = best.set_size;
-    st.new_hexes = best.new_hexes;
-    st.new_vertices = best.new_vertices;
-    st.forced_after = best.forced_after;
-    st.whole_boundary = best.whole;
-  } else {
-    ctx.warn("pillow: no shrink set gave a ball complex; the mesh is not pillowed");
+    if (pass > 0 && p.defects() >= defects) break;
+    defects = p.defects();
+    st.shrink_set += p.set_size;
+    st.new_hexes += p.new_hexes;
+    st.new_vertices += p.new_vertices;
+    st.dropped_hexes += p.dropped;
+    st.unserved_vertices = p.unserved;
+    st.forced_after = p.forced_after;
+    st.whole_boundary = st.whole_boundary || p.whole;
+    st.passes = pass + 1;
+    res.complex = std::move(p.complex);
+    forced = find_forced_configurations(surface, res.complex, params.forced_sj);
+    ctx.report("pillow", (pass + 1.0) / params.max_passes);
   }
   ctx.report("pillow", 1.0);
   st.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -204,10 +204,13 @@ nlohmann::json to_json(const MeshResult& r) {
                    {"forced_list", forced},
                    {"forced_after", p.forced_after},
                    {"excluded_vertices", p.excluded_vertices},
+                   {"dropped_hexes", p.dropped_hexes},
+                   {"unserved_vertices", p.unserved_vertices},
                    {"shrink_set", p.shrink_set},
                    {"new_hexes", p.new_hexes},
                    {"new_vertices", p.new_vertices},
-                   {"whole_boundary", p.whole_boundary}};
+                   {"whole_boundary", p.whole_boundary},
+                   {"passes", p.passes}};
     const UntangleStats& u = r.untangle;
     auto phase = [](const UntanglePhaseStats& s) {
       return nlohmann::json{{"rounds", s.rounds},

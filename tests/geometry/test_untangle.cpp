@@ -489,6 +489,56 @@ TEST(GeometryPipeline, GeneratedSurfacesMeshAllPositive) {
   EXPECT_GE(meshed, 4);
 }
 
+// Pillowed random voxel solids with saddle vertices (no direction inside every quad there): a
+// single copy of such a vertex cannot serve all its quads, so the shrink set is fitted to the
+// boundary. Before fitting, these two kept 2 and 3 hexes at SJ = 0 (their copies sat on the
+// saddle); now every hex is positive.
+TEST(GeometryPipeline, SaddleVerticesAreFittedAndAllPositive) {
+  for (uint64_t seed : {1, 8}) {
+    const Generated g = testing::pillowed(testing::random_voxel_solid(seed, 4, 12, 2), seed, 0.3);
+    SCOPED_TRACE(g.name);
+    MeshResult r = run_mesh(to_polygon_soup(g.surface));
+    ASSERT_TRUE(r.status.ok()) << to_string(r.status);
+    EXPECT_GT(r.pillow.excluded_vertices, 0);  // the surface has saddles
+    EXPECT_GT(r.pillow.new_hexes, 0);
+    EXPECT_EQ(r.pillow.forced_after, 0);
+    EXPECT_EQ(r.pillow.unserved_vertices, 0);
+    EXPECT_TRUE(r.quality.is_ball);
+    EXPECT_EQ(r.quality.boundary_matches_surface, true);
+    EXPECT_EQ(r.quality.sj_count_nonpositive, 0);
+    EXPECT_GT(r.quality.sj_min, 0.1);
+  }
+  // Seed 6 has a saddle all of whose hexes are forced: the first pass must keep one out, and a
+  // second, local pass pillows it with another copy of the vertex (topology only here).
+  const Generated g = testing::pillowed(testing::random_voxel_solid(6, 4, 12, 2), 6, 0.3);
+  MeshParams mp;
+  mp.untangle.untangle = false;
+  mp.untangle.optimize = false;
+  MeshResult r = run_mesh(to_polygon_soup(g.surface), mp);
+  ASSERT_TRUE(r.status.ok()) << to_string(r.status);
+  EXPECT_GT(r.pillow.dropped_hexes, 0);
+  EXPECT_EQ(r.pillow.passes, 2);
+  EXPECT_EQ(r.pillow.forced_after, 0);
+  EXPECT_EQ(r.pillow.unserved_vertices, 0);
+  EXPECT_TRUE(r.quality.is_ball);
+}
+
+// The fit on a small case by hand: a saddle-free cube pillowed whole keeps every hex (nothing to
+// drop) and needs one pass; a second pass is never taken when nothing is forced.
+TEST(GeometryPillow, WholePillowOfACubeDropsNothing) {
+  Generated g = testing::cube(2, 2, 2);
+  PillowParams pp;
+  pp.mode = PillowMode::all;
+  PillowResult pr = run_pillow(g.surface, complex_of(g), pp);
+  ASSERT_TRUE(pr.status.ok());
+  EXPECT_EQ(pr.stats.excluded_vertices, 0);
+  EXPECT_EQ(pr.stats.dropped_hexes, 0);
+  EXPECT_EQ(pr.stats.unserved_vertices, 0);
+  EXPECT_EQ(pr.stats.passes, 1);
+  EXPECT_EQ(pr.stats.shrink_set, 8);
+  EXPECT_EQ(pr.stats.new_hexes, 24);
+}
+
 TEST(GeometryPipeline, CubeGridStaysPerfect) {
   MeshResult r = run_mesh(to_polygon_soup(testing::cube(3, 3, 3).surface));
   ASSERT_TRUE(r.status.ok()) << to_string(r.status);
