@@ -10,7 +10,8 @@
 //
 // Exit codes: 0 success, 1 usage error, 2 bad input or file problem (for `quality`: also a mesh
 // with hexes of scaled Jacobian <= 0, not a ball, or not bounded by --surface), 3 meshing failed,
-// 4 internal error (a bug: please report it with the input).
+// 4 internal error (a bug: please report it with the input), 5 (`mesh`) the mesh was written but
+// has hexes with scaled Jacobian <= 0 (a warning on stderr says how many).
 #include "hexpeel/diagnosis.h"
 #include "hexpeel/io.h"
 #include "hexpeel/pipeline.h"
@@ -169,6 +170,13 @@ int cmd_mesh(const std::string& in, const std::string& out, const std::string& r
         std::printf("note: interior vertices are placed by a harmonic solve only (--no-untangle); "
                     "%d hexes are inverted or degenerate\n", q.sj_count_nonpositive);
     }
+  }
+  if (r.quality.sj_count_nonpositive > 0) {  // written, but not fit for a solver: say so
+    std::fprintf(stderr,
+                 "hexpeel: warning: %s has %d hexes with scaled Jacobian <= 0 (min %.4g); "
+                 "exit code 5\n",
+                 out.c_str(), r.quality.sj_count_nonpositive, r.quality.sj_min);
+    return 5;
   }
   return 0;
 }

@@ -376,6 +376,25 @@ TEST_F(Cli, MeshWritesMeshAndReport) {
   EXPECT_EQ(listing(), (std::vector<std::string>{"cube2.obj", "out.vtk", "report.json"}));
 }
 
+// A pillowed voxel solid whose reconstruction has hexes lying flat in the boundary (all 8
+// corners on it): without a pillow no placement helps, so the mesh is written and exit code 5
+// says it is not fit for a solver.
+TEST_F(Cli, MeshWithInvertedHexesExitsFive) {
+  const std::string in =
+      write("rvox.obj", gen::pillowed(gen::random_voxel_solid(1, 4, 12, 2), 1, 0.3).surface);
+  Outcome r = run({"mesh", in, "-o", path("out.vtk"), "--pillow", "none", "--quiet"});
+  EXPECT_NO_SIGNAL(r);
+  EXPECT_EQ(r.exit_code, 5) << r.out << r.err;
+  EXPECT_TRUE(contains(r.err, "scaled Jacobian <= 0")) << r.err;
+  ASSERT_TRUE(fs::exists(path("out.vtk")));
+  HexMesh mesh;
+  ASSERT_TRUE(read_hex_mesh(path("out.vtk"), mesh).ok());
+  EXPECT_GT(mesh.num_hexes(), 0);
+  // The default pillow serves it: exit 0.
+  Outcome ok = run({"mesh", in, "-o", path("ok.vtk"), "--quiet"});
+  EXPECT_EQ(ok.exit_code, 0) << ok.err;
+}
+
 TEST_F(Cli, MeshIsDeterministic) {
   const std::string in = write("sphere.obj", gen::cubed_sphere_equiangular(3).surface);
   for (const char* ext : {".vtk", ".vtu", ".mesh", ".msh"}) {
