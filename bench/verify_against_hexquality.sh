@@ -77,7 +77,8 @@ for s in "${surfaces[@]}"; do
   for ext in vtk vtu mesh msh; do
     "$bin" mesh "$s" -o "$work/$name.$ext" --quiet --time-limit "$time_limit" ${mesh_args[@]+"${mesh_args[@]}"} >"$work/mesh.out" 2>"$work/mesh.err"
     rc=$?
-    if [ $rc -ne 0 ]; then
+    # 5: written, with hexes at scaled Jacobian <= 0; the checkers below judge it.
+    if [ $rc -ne 0 ] && [ $rc -ne 5 ]; then
       echo "| $rel | .$ext | hexpeel mesh | - | - | - | - | - | - | - | mesh exit $rc: $(head -c 160 "$work/mesh.err" | tr '\n|' ' /') |"
       ok=0
       mesh_failures=$((mesh_failures + 1))
