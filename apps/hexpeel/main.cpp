@@ -5,7 +5,7 @@
 //                [--time-limit S] [--method original|kremer] [--no-zero-volume]
 //                [--no-enclosed] [--no-concave] [--no-false-positive] [--no-concave-waits]
 //                [--intrusion-fallback] [--pillow auto|all|none] [--no-untangle]
-//                [--no-optimize] [--solver lbfgs|newton] [--quiet]
+//                [--no-optimize] [--polish-iterations N] [--solver lbfgs|newton] [--quiet]
 //   hexpeel quality MESH [--surface IN] [--json FILE]
 //
 // Exit codes: 0 success, 1 usage error, 2 bad input or file problem (for `quality`: also a mesh
@@ -301,6 +301,10 @@ int main(int argc, char** argv) {
                  "keep the harmonic placement: no Winslow untangling (default: untangle)");
   mesh->add_flag("--no-optimize", no_optimize,
                  "skip the scaled-Jacobian optimization after untangling (default: optimize)");
+  mesh->add_option("--polish-iterations", params.untangle.max_mean_inner,
+                   "L-BFGS iterations of the mean polish that ends the optimization (raises the "
+                   "mean scaled Jacobian and never lowers the minimum; 0 = skip it, for speed)")
+      ->check(CLI::Range(0, 100000))->capture_default_str();
   std::string solver = "lbfgs";
   mesh->add_option("--solver", solver,
                    "untangling minimizer: lbfgs (L-BFGS) or newton (projected Newton with a "

@@ -101,6 +101,16 @@ struct UntangleParams {
   /// Phase 2 adds this times the phase 1 energy (eps ~ 0), which keeps edges from collapsing
   /// (the scaled Jacobian alone does not see size). Dimensionless, >= 0.
   double regularization = 0.1;
+  /// Phase 2 ends with a mean polish over the whole mesh: the restarts' objective plus
+  /// mean_weight exp(mean_beta (s_min - s)) per term, a flatter exponential that weighs every
+  /// corner nearly alike and so raises the typical one; at most max_mean_inner L-BFGS iterations
+  /// (0 skips it). It never lowers the minimum (see mean_pin). Dimensionless, > 0 / >= 0.
+  double mean_beta = 2.0;
+  double mean_weight = 1.0;
+  int max_mean_inner = 100;
+  /// The polish keeps every vertex of the hexes within this of the minimum where it is, and no
+  /// other corner may go below the minimum (dimensionless, >= 0).
+  double mean_pin = 0.05;
   /// Phase 2 restarts (re-centred on the new minimum), 0..1000; they also stop once a restart
   /// raises the minimum corner s by less than 1e-3. 6 (was 4): with focus_width the restarts are
   /// cheap, and csphere_n12 still gained 0.005 in its 4th.
@@ -142,6 +152,7 @@ struct UntangleStats {
   int32_t forced_nonpositive = 0;  ///< forced corners with det <= 0: no placement fixes them
   UntanglePhaseStats untangle, optimize;
   bool optimize_reverted = false;  ///< phase 2 made the minimum worse and was undone
+  bool mean_polish_kept = false;   ///< phase 2's mean polish ran and kept the minimum
   double final_eps = 0.0;
   double time_s = 0.0;
 };

@@ -518,6 +518,7 @@ NewtonRun newton(Problem& prob, NewtonSystem& sys, const WinslowKernel& kernel, 
 
 struct HexQuality {
   double min = 1.0;
+  double mean = 0.0;
   int32_t nonpositive = 0;
 };
 
@@ -534,8 +535,10 @@ HexQuality hex_quality(const HexMesh& mesh) {
                     });
   for (double s : sj) {
     q.min = std::min(q.min, s);
+    q.mean += s;
     if (s <= 0.0) ++q.nonpositive;
   }
+  if (!sj.empty()) q.mean /= static_cast<double>(sj.size());
   return q;
 }
 
@@ -742,6 +745,42 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
       const bool done = s - smin < 1e-3;
       smin = std::max(smin, s);
       if (done) break;
+    }
+    if (params.max_mean_inner > 0 && params.mean_weight > 0.0 && smin > 0.0) {
+      // Mean polish: the restarts' objective plus a flat exponential that weighs every corner
+      // nearly alike. The hexes within mean_pin of the minimum keep all 8 vertices where they
+      // are, every other corner must stay above the minimum, and the polish is undone if the
+      // minimum still ends lower.
+      const Eigen::VectorXd x_min = x;
+      prob.hex_min_value(hex_s);
+      std::vector<uint8_t> sub_fixed(prob.base.size(), 1);
+      for (int32_t v : prob.free_point) sub_fixed[v] = 0;
+      for (int32_t h = 0; h < prob.num_hexes(); ++h)
+        if (hex_s[h] < smin + params.mean_pin)
+          for (int32_t v : prob.hexes[h]) sub_fixed[v] = 1;
+      sub.base = prob.pos;
+      build_problem(sub, prob.hexes, sub_fixed, params.collinear_tol, nullptr, nullptr);
+      const int32_t ns = static_cast<int32_t>(sub.free_point.size());
+      QualityKernel km = k;
+      km.s_ref = smin;
+      km.floor = smin - 1e-9 * smin;
+      km.mean_beta = params.mean_beta;
+      km.mean_weight = params.mean_weight;
+      Eigen::VectorXd xs(3 * ns);
+      for (int32_t u = 0; u < ns; ++u) xs.segment<3>(3 * u) = sub.base[sub.free_point[u]];
+      const int ev_sub = sub.evaluations;
+      const int64_t cev_sub = sub.corner_evaluations;
+      if (ns > 0) res.stats.optimize.iterations += minimize(sub, km, xs, params, params.max_mean_inner);
+      res.stats.optimize.evaluations += sub.evaluations - ev_sub;
+      res.stats.optimize.corner_evaluations += sub.corner_evaluations - cev_sub;
+      for (int32_t u = 0; u < ns; ++u)
+        x.segment<3>(3 * prob.free_index[sub.free_point[u]]) = xs.segment<3>(3 * u);
+      prob.evaluate(x, g, k);
+      res.stats.mean_polish_kept = prob.min_corner_value() >= smin;
+      if (!res.stats.mean_polish_kept) {
+        x = x_min;
+        prob.evaluate(x, g, k);
+      }
     }
     res.stats.optimize.evaluations += prob.evaluations - ev0;
     res.stats.optimize.corner_evaluations += prob.corner_evaluations - cev0;

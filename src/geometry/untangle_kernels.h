@@ -254,6 +254,10 @@ struct QualityKernel {
   double beta, s_ref, floor;  ///< a trial point with s <= floor is rejected (energy +inf)
   double mu;                  ///< weight of the Winslow regularizer
   WinslowKernel winslow;
+  /// A second, flatter exponential: + mean_weight exp(mean_beta (s_ref - s)) per term. With a
+  /// small mean_beta every corner weighs nearly alike, which keeps the typical corner up while
+  /// beta's term lifts the worst (0 = off).
+  double mean_beta = 0.0, mean_weight = 0.0;
   double operator()(const Vec3& e0, const Vec3& e1, const Vec3& e2, Vec3& g0, Vec3& g1, Vec3& g2,
                     double& s) const {
     const Vec3 d0 = e1.cross(e2), d1 = e2.cross(e0), d2 = e0.cross(e1);
@@ -273,8 +277,10 @@ struct QualityKernel {
       g0 = g1 = g2 = Vec3::Zero();
       return std::numeric_limits<double>::infinity();
     }
-    const double f = std::exp(beta * (s_ref - s));
-    const double k = -beta * f;  // df/ds
+    const double f1 = std::exp(beta * (s_ref - s));
+    const double f2 = mean_weight != 0.0 ? mean_weight * std::exp(mean_beta * (s_ref - s)) : 0.0;
+    const double f = f1 + f2;
+    const double k = -beta * f1 - mean_beta * f2;  // df/ds
     const double kl = k * inv_l, ks = k * s * inv_pr;
     Vec3 w0, w1, w2;
     double wdet;
@@ -310,13 +316,16 @@ struct QualityKernel {
     for (int i = 0; i < hc.n; ++i) winslow.reciprocals(hc.det[i], inv_c[i], inv_r[i]);
     for (int i = 0; i < hc.n; ++i) c23[i] = inv_c[i] * inv_cbrt(inv_c[i]);
     for (int i = 0; i < hc.n; ++i) ex[i] = std::exp(beta * (s_ref - s[i]));
+    double ex2[kHexTerms];
+    for (int i = 0; i < hc.n; ++i)
+      ex2[i] = mean_weight != 0.0 ? mean_weight * std::exp(mean_beta * (s_ref - s[i])) : 0.0;
     double f = 0.0;
     for (int i = 0; i < hc.n; ++i) {
       double k2, kd;
       const double fw = winslow.finish(a2[i] + b2[i] + c2[i], hc.det[i], inv_c[i], inv_r[i], c23[i],
                                        k2, kd);
-      f += ex[i] + mu * fw;
-      const double k = -beta * ex[i];  // df/ds
+      f += ex[i] + ex2[i] + mu * fw;
+      const double k = -beta * ex[i] - mean_beta * ex2[i];  // df/ds
       const double kl = k * inv_l[i], ks = k * s[i] * inv_pr[i];
       hc.scatter(i, mu * k2 - ks * b2[i] * c2[i], mu * k2 - ks * a2[i] * c2[i],
                  mu * k2 - ks * a2[i] * b2[i], kl + mu * kd, g);

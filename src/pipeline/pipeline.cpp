@@ -238,6 +238,7 @@ nlohmann::json to_json(const MeshResult& r) {
                      {"untangle", phase(u.untangle)},
                      {"optimize", phase(u.optimize)},
                      {"optimize_reverted", u.optimize_reverted},
+                     {"mean_polish_kept", u.mean_polish_kept},
                      {"time_s", u.time_s}};
   }
   j["timings_s"] = {{"check", r.timings.check_s},

@@ -365,6 +365,25 @@ TEST(GeometryUntangle, OptimizeNeverLowersTheMinimum) {
   EXPECT_EQ(run_quality(b.mesh).sj_count_nonpositive, 0);
 }
 
+// The mean polish raises the mean scaled Jacobian and leaves the minimum where the restarts put
+// it (the hexes near it are pinned, no other corner may drop below it).
+TEST(GeometryUntangle, MeanPolishRaisesTheMeanAndKeepsTheMinimum) {
+  Generated g = testing::jittered(testing::cubed_sphere_equiangular(4), 5, 0.2);
+  UntangleParams p;
+  p.max_mean_inner = 0;
+  UntangleResult a = run_untangle(g.known_mesh, surface_fixed(g), p);
+  p.max_mean_inner = 100;
+  UntangleResult b = run_untangle(g.known_mesh, surface_fixed(g), p);
+  const QualityReport qa = run_quality(a.mesh), qb = run_quality(b.mesh);
+  EXPECT_FALSE(a.stats.mean_polish_kept);
+  EXPECT_TRUE(b.stats.mean_polish_kept);
+  EXPECT_GE(qb.sj_min, qa.sj_min);
+  EXPECT_GT(qb.sj_mean, qa.sj_mean + 0.005);
+  EXPECT_EQ(qb.sj_count_nonpositive, 0);
+  for (int32_t v = 0; v < g.surface.num_points(); ++v)
+    ASSERT_EQ(b.mesh.points[v], g.known_mesh.points[v]) << "vertex " << v;
+}
+
 /// A 2x2x3 grid whose hex at [0,1]^2 x [1,2] has its front (y=0) and left (x=0) boundary faces
 /// made coplanar (the shared edge moved to x = y = 0.5): a flat doublet.
 Generated flat_doublet() {
