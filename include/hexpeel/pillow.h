@@ -57,7 +57,7 @@ struct PillowParams {
   /// on cubed spheres and pillowed grids the whole layer then gives the higher minimum
   /// (csphere_n12 0.77 vs 0.51), while sparse forced corners are better served locally.
   double whole_fraction = 0.25;
-  /// Pillow passes at most (>= 1). A pass after the first pillows, locally, forced hexes the
+  /// Pillow passes at most (values below 1 count as 1). A pass after the first pillows, locally, forced hexes the
   /// previous one had to keep out of S (at a saddle vertex), giving that vertex another copy; it
   /// is kept only when it lowers the count of forced corners and unserved vertices.
   int max_passes = 3;

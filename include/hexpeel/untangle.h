@@ -109,7 +109,7 @@ struct UntangleParams {
   double mean_weight = 1.0;
   int max_mean_inner = 100;
   /// The polish keeps every vertex of the hexes within this of the minimum where it is, and no
-  /// other corner may go below the minimum (dimensionless, >= 0).
+  /// other corner may reach the minimum (dimensionless, > 0).
   double mean_pin = 0.05;
   /// Phase 2 restarts (re-centred on the new minimum), 0..1000; they also stop once a restart
   /// raises the minimum corner s by less than 1e-3. 6 (was 4): with focus_width the restarts are

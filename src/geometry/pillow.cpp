@@ -389,26 +389,29 @@ PillowResult run_pillow(const QuadSurface& surface, const HexComplex& complex,
   // with a second copy of the vertex. Each later pass must lower the defects.
   std::vector<ForcedConfiguration> forced = res.forced;
   int32_t defects = st.forced;
-  for (int pass = 0; pass < params.max_passes && (pass == 0 || !forced.empty()); ++pass) {
+  int32_t unserved = 0;  // copies without an inward direction, summed over the passes kept
+  const int max_passes = std::max(1, params.max_passes);
+  for (int pass = 0; pass < max_passes && (pass == 0 || !forced.empty()); ++pass) {
     PillowPass p;
     const bool local = params.mode == PillowMode::automatic || pass > 0;
     if (!pillow_once(surface, res.complex, forced, params, local, pass == 0, &p)) {
       if (pass == 0) ctx.warn("pillow: no shrink set gave a ball complex; the mesh is not pillowed");
       break;
     }
-    if (pass > 0 && p.defects() >= defects) break;
-    defects = p.defects();
+    if (pass > 0 && p.defects() + unserved >= defects) break;
+    unserved += p.unserved;
+    defects = p.forced_after + unserved;
     st.shrink_set += p.set_size;
     st.new_hexes += p.new_hexes;
     st.new_vertices += p.new_vertices;
     st.dropped_hexes += p.dropped;
-    st.unserved_vertices = p.unserved;
+    st.unserved_vertices = unserved;
     st.forced_after = p.forced_after;
     st.whole_boundary = st.whole_boundary || p.whole;
     st.passes = pass + 1;
     res.complex = std::move(p.complex);
     forced = find_forced_configurations(surface, res.complex, params.forced_sj);
-    ctx.report("pillow", (pass + 1.0) / params.max_passes);
+    ctx.report("pillow", (pass + 1.0) / max_passes);
   }
   ctx.report("pillow", 1.0);
   st.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -746,24 +746,26 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
       smin = std::max(smin, s);
       if (done) break;
     }
-    if (params.max_mean_inner > 0 && params.mean_weight > 0.0 && smin > 0.0) {
+    if (params.max_mean_inner > 0 && params.mean_weight > 0.0 && params.mean_pin > 0.0 &&
+        smin > 0.0) {
       // Mean polish: the restarts' objective plus a flat exponential that weighs every corner
       // nearly alike. The hexes within mean_pin of the minimum keep all 8 vertices where they
       // are, every other corner must stay above the minimum, and the polish is undone if the
       // minimum still ends lower.
       const Eigen::VectorXd x_min = x;
+      const double s_now = prob.min_corner_value();  // at x (a last restart may have lost a bit)
       prob.hex_min_value(hex_s);
       std::vector<uint8_t> sub_fixed(prob.base.size(), 1);
       for (int32_t v : prob.free_point) sub_fixed[v] = 0;
       for (int32_t h = 0; h < prob.num_hexes(); ++h)
-        if (hex_s[h] < smin + params.mean_pin)
+        if (hex_s[h] < s_now + params.mean_pin)
           for (int32_t v : prob.hexes[h]) sub_fixed[v] = 1;
       sub.base = prob.pos;
       build_problem(sub, prob.hexes, sub_fixed, params.collinear_tol, nullptr, nullptr);
       const int32_t ns = static_cast<int32_t>(sub.free_point.size());
       QualityKernel km = k;
-      km.s_ref = smin;
-      km.floor = smin - 1e-9 * smin;
+      km.s_ref = s_now;
+      km.floor = s_now;  // the hexes it evaluates start at >= s_now + mean_pin (the rest pinned)
       km.mean_beta = params.mean_beta;
       km.mean_weight = params.mean_weight;
       Eigen::VectorXd xs(3 * ns);
@@ -776,7 +778,7 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
       for (int32_t u = 0; u < ns; ++u)
         x.segment<3>(3 * prob.free_index[sub.free_point[u]]) = xs.segment<3>(3 * u);
       prob.evaluate(x, g, k);
-      res.stats.mean_polish_kept = prob.min_corner_value() >= smin;
+      res.stats.mean_polish_kept = ns > 0 && prob.min_corner_value() >= s_now;
       if (!res.stats.mean_polish_kept) {
         x = x_min;
         prob.evaluate(x, g, k);
@@ -790,6 +792,7 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
     if (q2.min < res.stats.optimize.min_sj_before || q2.nonpositive > res.stats.optimize.nonpositive_before) {
       res.mesh = std::move(before);
       res.stats.optimize_reverted = true;
+      res.stats.mean_polish_kept = false;
     } else {
       res.stats.optimize.min_sj_after = q2.min;
       res.stats.optimize.nonpositive_after = q2.nonpositive;

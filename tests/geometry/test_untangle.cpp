@@ -131,6 +131,7 @@ TEST(GeometryUntangle, HexKernelsMatchCornerKernels) {
     untangle_detail::WinslowKernel w{trial % 4 == 0 ? 1e-10 : 0.3, 1.0};
     untangle_detail::QualityKernel q{30.0, 0.2, -std::numeric_limits<double>::infinity(), 0.1,
                                      untangle_detail::WinslowKernel{1e-10, 1.0}};
+    if (trial % 2 == 1) q.mean_beta = 2.0, q.mean_weight = 1.0;  // the mean polish's term
     auto check = [&](const auto& kernel) {
       Vec3 g_hex[8], g_ref[8];
       for (int k = 0; k < 8; ++k) g_hex[k].setZero(), g_ref[k].setZero();
@@ -175,6 +176,7 @@ TEST(GeometryUntangle, CentreTermGradientAndVerdictMinimum) {
     untangle_detail::WinslowKernel w{0.3, 1.0};
     untangle_detail::QualityKernel q{30.0, 0.2, -std::numeric_limits<double>::infinity(), 0.1,
                                      untangle_detail::WinslowKernel{0.3, 1.0}};
+    if (trial % 2 == 1) q.mean_beta = 2.0, q.mean_weight = 1.0;  // the mean polish's term
     auto check_gradient = [&](const auto& kernel) {
       Vec3 g[8];
       for (auto& v : g) v.setZero();
@@ -376,7 +378,6 @@ TEST(GeometryUntangle, MeanPolishRaisesTheMeanAndKeepsTheMinimum) {
   p.max_mean_inner = 100;
   UntangleResult b = run_untangle(g.known_mesh, surface_fixed(g), p);
   const QualityReport qa = run_quality(a.mesh), qb = run_quality(b.mesh);
-  EXPECT_FALSE(a.stats.mean_polish_kept);
   EXPECT_TRUE(b.stats.mean_polish_kept);
   EXPECT_GE(qb.sj_min, qa.sj_min);
   EXPECT_GT(qb.sj_mean, qa.sj_mean + 0.005);
