@@ -162,9 +162,26 @@ int32_t count_saddles(const std::vector<std::vector<BoundaryCorner>>& corners, i
   return n;
 }
 
+/// The best inward margin max_d min_n (-d . n) over the pillowed quads at a vertex, within 1e-3
+/// (bisection on has_inward_direction); 1 when no quad there is pillowed.
+double inward_margin(const std::vector<BoundaryCorner>& corners, const std::vector<uint8_t>& in_s,
+                     std::vector<Vec3>& scratch) {
+  scratch.clear();
+  for (const BoundaryCorner& c : corners)
+    if (in_s[c.hex]) scratch.push_back(c.normal);
+  if (scratch.empty()) return 1.0;
+  double lo = -1.0, hi = 1.0;
+  for (int i = 0; i < 11; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (has_inward_direction(scratch, mid) ? lo : hi) = mid;
+  }
+  return lo;
+}
+
 /// Drops hexes from S until every boundary vertex's copy can be served (copy_can_serve). At a
 /// vertex that fails, one hex at a time leaves S: a hex that is not forced before one that is, one
-/// whose removal alone makes the rest servable first, then the lowest id. Dropping only removes
+/// whose removal alone makes the rest servable first, then the one whose removal leaves the
+/// largest inward margin (the most conflicting quad), then the lowest id. Dropping only removes
 /// normals at other vertices, so one pass over the vertices suffices. Returns the hexes dropped.
 int32_t fit_to_boundary(std::vector<uint8_t>& in_s,
                         const std::vector<std::vector<BoundaryCorner>>& corners,
@@ -174,13 +191,14 @@ int32_t fit_to_boundary(std::vector<uint8_t>& in_s,
   for (const std::vector<BoundaryCorner>& cs : corners) {
     while (!cs.empty() && !copy_can_serve(cs, in_s, scratch)) {
       int32_t pick = -1;
-      std::tuple<int, int, int32_t> pick_key{};
+      std::tuple<int, int, double, int32_t> pick_key{};
       for (const BoundaryCorner& c : cs) {
         if (!in_s[c.hex]) continue;
         in_s[c.hex] = 0;
         const bool fixes = copy_can_serve(cs, in_s, scratch);
+        const double margin = inward_margin(cs, in_s, scratch);
         in_s[c.hex] = 1;
-        const std::tuple<int, int, int32_t> key{forced[c.hex], !fixes, c.hex};
+        const std::tuple<int, int, double, int32_t> key{forced[c.hex], !fixes, -margin, c.hex};
         if (pick < 0 || key < pick_key) {
           pick = c.hex;
           pick_key = key;
