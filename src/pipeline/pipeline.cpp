@@ -239,6 +239,7 @@ nlohmann::json to_json(const MeshResult& r) {
                      {"optimize", phase(u.optimize)},
                      {"optimize_reverted", u.optimize_reverted},
                      {"mean_polish_kept", u.mean_polish_kept},
+                     {"local_moves", u.local_moves},
                      {"time_s", u.time_s}};
   }
   j["timings_s"] = {{"check", r.timings.check_s},

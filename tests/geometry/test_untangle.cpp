@@ -373,6 +373,7 @@ TEST(GeometryUntangle, OptimizeNeverLowersTheMinimum) {
 TEST(GeometryUntangle, MeanPolishRaisesTheMeanAndKeepsTheMinimum) {
   Generated g = testing::jittered(testing::cubed_sphere_equiangular(4), 5, 0.2);
   UntangleParams p;
+  p.local_sweeps = 0;  // the polish alone
   p.max_mean_inner = 0;
   UntangleResult a = run_untangle(g.known_mesh, surface_fixed(g), p);
   p.max_mean_inner = 100;
@@ -384,6 +385,23 @@ TEST(GeometryUntangle, MeanPolishRaisesTheMeanAndKeepsTheMinimum) {
   EXPECT_EQ(qb.sj_count_nonpositive, 0);
   for (int32_t v = 0; v < g.surface.num_points(); ++v)
     ASSERT_EQ(b.mesh.points[v], g.known_mesh.points[v]) << "vertex " << v;
+}
+
+// The local max-min sweeps at the end of phase 2 raise the minimum (never lower it) and keep
+// the boundary. A pillowed voxel solid, whose worst hex has free corners (measured: 0.237 ->
+// 0.287 with the sweeps).
+TEST(GeometryPipeline, LocalSweepsRaiseTheMinimum) {
+  const Generated g = testing::pillowed(testing::random_voxel_solid(5, 4, 12, 2), 5, 0.3);
+  MeshParams p;
+  p.untangle.local_sweeps = 0;
+  MeshResult a = run_mesh(to_polygon_soup(g.surface), p);
+  MeshResult b = run_mesh(to_polygon_soup(g.surface));
+  ASSERT_TRUE(a.status.ok() && b.status.ok()) << to_string(b.status);
+  EXPECT_EQ(a.untangle.local_moves, 0);
+  EXPECT_GT(b.untangle.local_moves, 0);
+  EXPECT_GT(b.quality.sj_min, a.quality.sj_min + 0.01);
+  EXPECT_EQ(b.quality.sj_count_nonpositive, 0);
+  EXPECT_EQ(b.quality.boundary_matches_surface, true);
 }
 
 /// A 2x2x3 grid whose hex at [0,1]^2 x [1,2] has its front (y=0) and left (x=0) boundary faces
