@@ -153,12 +153,12 @@ bool copy_can_serve(const std::vector<BoundaryCorner>& corners, const std::vecto
   return has_inward_direction(scratch, kInwardMargin);
 }
 
-/// Boundary vertices that no shrink set holding all their hexes can serve (a saddle, say).
-int32_t count_saddles(const std::vector<std::vector<BoundaryCorner>>& corners, int32_t num_hexes) {
-  const std::vector<uint8_t> all(num_hexes, 1);
+/// Boundary vertices whose copy S (in_s) cannot serve; with S = every hex, the saddles.
+int32_t count_unserved(const std::vector<std::vector<BoundaryCorner>>& corners,
+                       const std::vector<uint8_t>& in_s) {
   std::vector<Vec3> scratch;
   int32_t n = 0;
-  for (const auto& cs : corners) n += !cs.empty() && !copy_can_serve(cs, all, scratch);
+  for (const auto& cs : corners) n += !cs.empty() && !copy_can_serve(cs, in_s, scratch);
   return n;
 }
 
@@ -314,13 +314,14 @@ struct PillowPass {
 
 /// Pillows `complex` once around `forced` (its forced configurations): the local shrink set when
 /// `local` and it is small enough (any size when not `whole`), else (or when that leaves
-/// defects) the whole set when `whole` and it does better. False when no set gives a ball.
+/// defects) the whole set when `whole` and it does better; `nb` and `corners` are the complex's
+/// face_neighbours and boundary_corners. False when no set gives a ball.
 bool pillow_once(const QuadSurface& surface, const HexComplex& complex,
+                 const std::vector<int32_t>& nb,
+                 const std::vector<std::vector<BoundaryCorner>>& corners,
                  const std::vector<ForcedConfiguration>& forced, const PillowParams& params,
                  bool local, bool whole, PillowPass* out) {
   const int32_t nh = static_cast<int32_t>(complex.hexes.size());
-  const std::vector<int32_t> nb = face_neighbours(complex.hexes);
-  const std::vector<std::vector<BoundaryCorner>> corners = boundary_corners(surface, complex, nb);
   std::vector<uint8_t> forced_hex(nh, 0);
   for (const ForcedConfiguration& f : forced) forced_hex[f.hex] = 1;
 
@@ -335,8 +336,7 @@ bool pillow_once(const QuadSurface& surface, const HexComplex& complex,
     if (!is_ball(c.complex)) return false;
     c.forced_after =
         static_cast<int32_t>(find_forced_configurations(surface, c.complex, params.forced_sj).size());
-    std::vector<Vec3> scratch;
-    for (const auto& cs : corners) c.unserved += !cs.empty() && !copy_can_serve(cs, in_s, scratch);
+    c.unserved = count_unserved(corners, in_s);
     *res = std::move(c);
     return true;
   };
@@ -397,11 +397,9 @@ PillowResult run_pillow(const QuadSurface& surface, const HexComplex& complex,
     st.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return res;
   }
-  {
-    const std::vector<int32_t> nb = face_neighbours(complex.hexes);
-    st.excluded_vertices = count_saddles(boundary_corners(surface, complex, nb),
-                                         static_cast<int32_t>(complex.hexes.size()));
-  }
+  std::vector<int32_t> nb = face_neighbours(complex.hexes);
+  std::vector<std::vector<BoundaryCorner>> corners = boundary_corners(surface, complex, nb);
+  st.excluded_vertices = count_unserved(corners, std::vector<uint8_t>(complex.hexes.size(), 1));
   // Later passes: a forced hex that had to stay out of S (at a saddle, its quads and those of
   // the other pillowed hexes there have no common inward direction) is pillowed again, locally,
   // with a second copy of the vertex. Each later pass must lower the defects.
@@ -412,7 +410,11 @@ PillowResult run_pillow(const QuadSurface& surface, const HexComplex& complex,
   for (int pass = 0; pass < max_passes && (pass == 0 || !forced.empty()); ++pass) {
     PillowPass p;
     const bool local = params.mode == PillowMode::automatic || pass > 0;
-    if (!pillow_once(surface, res.complex, forced, params, local, pass == 0, &p)) {
+    if (pass > 0) {  // the complex changed: its faces and boundary corners with it
+      nb = face_neighbours(res.complex.hexes);
+      corners = boundary_corners(surface, res.complex, nb);
+    }
+    if (!pillow_once(surface, res.complex, nb, corners, forced, params, local, pass == 0, &p)) {
       if (pass == 0) ctx.warn("pillow: no shrink set gave a ball complex; the mesh is not pillowed");
       break;
     }

@@ -519,7 +519,6 @@ NewtonRun newton(Problem& prob, NewtonSystem& sys, const WinslowKernel& kernel, 
 
 struct HexQuality {
   double min = 1.0;
-  double mean = 0.0;
   int32_t nonpositive = 0;
 };
 
@@ -536,10 +535,8 @@ HexQuality hex_quality(const HexMesh& mesh) {
                     });
   for (double s : sj) {
     q.min = std::min(q.min, s);
-    q.mean += s;
     if (s <= 0.0) ++q.nonpositive;
   }
-  if (!sj.empty()) q.mean /= static_cast<double>(sj.size());
   return q;
 }
 
@@ -547,26 +544,43 @@ HexQuality hex_quality(const HexMesh& mesh) {
 
 namespace {
 
+/// Minimizes `kernel` over the free points of `prob` that `sub_fixed` leaves free, the others
+/// pinned where x has them (prob.pos must hold x: evaluate() last called at x), at most
+/// `iterations` L-BFGS iterations, and writes the result back into x. `sub` is reused storage.
+/// Returns the number of points the region freed; adds the work to `st`.
+int32_t minimize_region(Problem& prob, Problem& sub, const std::vector<uint8_t>& sub_fixed,
+                        const QualityKernel& kernel, Eigen::VectorXd& x,
+                        const UntangleParams& params, int iterations, UntanglePhaseStats& st) {
+  sub.base = prob.pos;
+  build_problem(sub, prob.hexes, sub_fixed, params.collinear_tol, nullptr, nullptr);
+  const int32_t ns = static_cast<int32_t>(sub.free_point.size());
+  Eigen::VectorXd xs(3 * ns);
+  for (int32_t u = 0; u < ns; ++u) xs.segment<3>(3 * u) = sub.base[sub.free_point[u]];
+  const int ev_sub = sub.evaluations;
+  const int64_t cev_sub = sub.corner_evaluations;
+  st.iterations += minimize(sub, kernel, xs, params, iterations);
+  st.evaluations += sub.evaluations - ev_sub;
+  st.corner_evaluations += sub.corner_evaluations - cev_sub;
+  for (int32_t u = 0; u < ns; ++u)
+    x.segment<3>(3 * prob.free_index[sub.free_point[u]]) = xs.segment<3>(3 * u);
+  return ns;
+}
+
 /// Local max-min sweeps (UntangleParams::local_sweeps). Each sweep takes the free vertices of the
 /// local_hexes hexes with the lowest scaled Jacobian, worst first, and moves each by a pattern
 /// search over 14 directions (axes and diagonals) that accepts a step only when it keeps the
 /// minimum scaled Jacobian of the vertex's hexes and raises that minimum plus local_mean_weight
-/// times their mean; the step starts at a tenth of the vertex's
-/// mean edge length and halves when no direction helps, down to 1/1000 of it. The smoothed
+/// times their mean; the step starts at a tenth of the vertex's mean distance to the other points
+/// of its hexes and halves when no direction helps, down to 1/1000 of it. The smoothed
 /// objectives spread their gradient over many corners; this one moves the worst hex's vertices
 /// directly. Sequential, so deterministic, and the global minimum never drops. Returns the moves.
-int64_t local_max_min(const std::vector<Hex>& hexes, const std::vector<int32_t>& free_index,
-                      std::vector<Vec3>& pts, const UntangleParams& params) {
+int64_t local_max_min(const Problem& prob, std::vector<Vec3>& pts, const UntangleParams& params) {
+  const std::vector<Hex>& hexes = prob.hexes;
   const int32_t nh = static_cast<int32_t>(hexes.size());
   const int32_t np = static_cast<int32_t>(pts.size());
-  std::vector<int32_t> start(np + 1, 0), inc;
-  for (const Hex& h : hexes)
-    for (int32_t v : h) ++start[v + 1];
-  for (int32_t v = 0; v < np; ++v) start[v + 1] += start[v];
-  inc.resize(start[np]);
-  std::vector<int32_t> fill(start.begin(), start.end() - 1);
-  for (int32_t h = 0; h < nh; ++h)
-    for (int32_t v : hexes[h]) inc[fill[v]++] = h;
+  // The hexes of free point v: slots inc_slot[i] / 8 for i in the range of its unknown.
+  auto first = [&](int32_t v) { return prob.inc_start[prob.free_index[v]]; };
+  auto last = [&](int32_t v) { return prob.inc_start[prob.free_index[v] + 1]; };
   auto hex_sj = [&](int32_t h) {
     std::array<Vec3, 8> c;
     for (int k = 0; k < 8; ++k) c[k] = pts[hexes[h][k]];
@@ -575,12 +589,12 @@ int64_t local_max_min(const std::vector<Hex>& hexes, const std::vector<int32_t>&
   // (min, mean) of the scaled Jacobians of v's hexes
   auto vertex_quality = [&](int32_t v) {
     double m = std::numeric_limits<double>::infinity(), sum = 0.0;
-    for (int32_t i = start[v]; i < start[v + 1]; ++i) {
-      const double q = hex_sj(inc[i]);
+    for (int32_t i = first(v); i < last(v); ++i) {
+      const double q = hex_sj(prob.inc_slot[i] / 8);
       m = std::min(m, q);
       sum += q;
     }
-    return std::pair<double, double>{m, sum / std::max<int32_t>(1, start[v + 1] - start[v])};
+    return std::pair<double, double>{m, sum / std::max<int32_t>(1, last(v) - first(v))};
   };
   // A step must not lower the minimum and must raise minimum + local_mean_weight * mean.
   auto score = [&](const std::pair<double, double>& q) {
@@ -612,13 +626,13 @@ int64_t local_max_min(const std::vector<Hex>& hexes, const std::vector<int32_t>&
     std::vector<uint8_t> seen(np, 0);
     for (int32_t i = 0; i < k; ++i)
       for (int32_t v : hexes[order[i]])
-        if (free_index[v] >= 0 && !seen[v]) seen[v] = 1, verts.push_back(v);
+        if (prob.free_index[v] >= 0 && !seen[v]) seen[v] = 1, verts.push_back(v);
     const int64_t moves_before = moves;
     for (int32_t v : verts) {
       double len = 0.0;
       int count = 0;
-      for (int32_t i = start[v]; i < start[v + 1]; ++i)
-        for (int32_t w : hexes[inc[i]])
+      for (int32_t i = first(v); i < last(v); ++i)
+        for (int32_t w : hexes[prob.inc_slot[i] / 8])
           if (w != v) len += (pts[w] - pts[v]).norm(), ++count;
       const double l = count > 0 ? len / count : 0.0;
       std::pair<double, double> cur = vertex_quality(v);
@@ -823,18 +837,8 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
         }
         std::vector<uint8_t> sub_fixed(prob.base.size(), 1);
         for (int32_t v : prob.free_point) sub_fixed[v] = in_region[v] ? 0 : 1;
-        sub.base = prob.pos;  // prob.pos holds x: evaluate() was last called at x
-        build_problem(sub, prob.hexes, sub_fixed, params.collinear_tol, nullptr, nullptr);
-        const int32_t ns = static_cast<int32_t>(sub.free_point.size());
-        Eigen::VectorXd xs(3 * ns);
-        for (int32_t u = 0; u < ns; ++u) xs.segment<3>(3 * u) = sub.base[sub.free_point[u]];
-        const int ev_sub = sub.evaluations;
-        const int64_t cev_sub = sub.corner_evaluations;
-        res.stats.optimize.iterations += minimize(sub, k, xs, params, params.max_quality_inner);
-        res.stats.optimize.evaluations += sub.evaluations - ev_sub;
-        res.stats.optimize.corner_evaluations += sub.corner_evaluations - cev_sub;
-        for (int32_t u = 0; u < ns; ++u)
-          x.segment<3>(3 * prob.free_index[sub.free_point[u]]) = xs.segment<3>(3 * u);
+        minimize_region(prob, sub, sub_fixed, k, x, params, params.max_quality_inner,
+                        res.stats.optimize);
       } else {
         res.stats.optimize.iterations += minimize(prob, k, x, params, params.max_quality_inner);
       }
@@ -860,23 +864,13 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
       for (int32_t h = 0; h < prob.num_hexes(); ++h)
         if (hex_s[h] < s_now + params.mean_pin)
           for (int32_t v : prob.hexes[h]) sub_fixed[v] = 1;
-      sub.base = prob.pos;
-      build_problem(sub, prob.hexes, sub_fixed, params.collinear_tol, nullptr, nullptr);
-      const int32_t ns = static_cast<int32_t>(sub.free_point.size());
       QualityKernel km = k;
       km.s_ref = s_now;
       km.floor = s_now;  // the hexes it evaluates start at >= s_now + mean_pin (the rest pinned)
       km.mean_beta = params.mean_beta;
       km.mean_weight = params.mean_weight;
-      Eigen::VectorXd xs(3 * ns);
-      for (int32_t u = 0; u < ns; ++u) xs.segment<3>(3 * u) = sub.base[sub.free_point[u]];
-      const int ev_sub = sub.evaluations;
-      const int64_t cev_sub = sub.corner_evaluations;
-      if (ns > 0) res.stats.optimize.iterations += minimize(sub, km, xs, params, params.max_mean_inner);
-      res.stats.optimize.evaluations += sub.evaluations - ev_sub;
-      res.stats.optimize.corner_evaluations += sub.corner_evaluations - cev_sub;
-      for (int32_t u = 0; u < ns; ++u)
-        x.segment<3>(3 * prob.free_index[sub.free_point[u]]) = xs.segment<3>(3 * u);
+      const int32_t ns = minimize_region(prob, sub, sub_fixed, km, x, params,
+                                         params.max_mean_inner, res.stats.optimize);
       prob.evaluate(x, g, k);
       res.stats.mean_polish_kept = ns > 0 && prob.min_corner_value() >= s_now;
       if (!res.stats.mean_polish_kept) {
@@ -888,10 +882,8 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
       std::vector<Vec3> pts = prob.base;
       const int32_t nu = static_cast<int32_t>(prob.free_point.size());
       for (int32_t u = 0; u < nu; ++u) pts[prob.free_point[u]] = x.segment<3>(3 * u);
-      res.stats.local_moves = local_max_min(prob.hexes, prob.free_index, pts, params);
+      res.stats.local_moves = local_max_min(prob, pts, params);
       for (int32_t u = 0; u < nu; ++u) x.segment<3>(3 * u) = pts[prob.free_point[u]];
-      prob.evaluate(x, g, k);
-      smin = std::max(smin, prob.min_corner_value());
     }
     res.stats.optimize.evaluations += prob.evaluations - ev0;
     res.stats.optimize.corner_evaluations += prob.corner_evaluations - cev0;
