@@ -114,6 +114,7 @@ int main(int argc, char** argv) {
     variants.back().params.reconstruction.fallback_to_extrusion = true;
   }
   for (Variant& v : variants) {
+    v.params.alternatives = 0;  // each variant's own order, not the pipeline's fallbacks
     v.params.elimination.time_limit_s = time_limit;
     v.params.search = search;
     if (!optimize) {

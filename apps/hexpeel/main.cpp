@@ -2,10 +2,13 @@
 //
 //   hexpeel check IN [--sharp-angle DEG] [--json FILE]
 //   hexpeel mesh IN -o OUT [--report FILE] [--dump-stuck FILE] [--sharp-angle DEG]
-//                [--time-limit S] [--method original|kremer] [--no-zero-volume]
-//                [--no-enclosed] [--no-concave] [--no-false-positive] [--no-concave-waits]
-//                [--intrusion-fallback] [--pillow auto|all|none] [--no-untangle]
-//                [--no-optimize] [--polish-iterations N] [--solver lbfgs|newton] [--quiet]
+//                [--time-limit S] [--planner search|greedy] [--plan-budget S]
+//                [--improve-budget S] [--seed N] [--side-rule cost|heavier] [--side-threshold W]
+//                [--method original|kremer] [--no-zero-volume] [--no-enclosed] [--no-concave]
+//                [--no-false-positive] [--no-concave-waits] [--strict-intrusion]
+//                [--pillow auto|all|none] [--no-untangle] [--no-optimize]
+//                [--polish-iterations N] [--solver lbfgs|newton] [--alternatives N]
+//                [--alternatives-always] [--quiet]
 //   hexpeel quality MESH [--surface IN] [--json FILE]
 //
 // Exit codes: 0 success, 1 usage error, 2 bad input or file problem (for `quality`: also a mesh
@@ -147,8 +150,23 @@ int cmd_mesh(const std::string& in, const std::string& out, const std::string& r
                 r.diagnosis.validation.surface.num_quads(), r.diagnosis.chord_stats.count,
                 out.c_str(), q.hexes,
                 read_s + r.timings.check_s + r.timings.elimination_s + r.timings.reconstruction_s +
-                    r.timings.pillow_s + r.timings.placement_s + r.timings.untangle_s + r.timings.quality_s + write_s,
+                    r.timings.pillow_s + r.timings.placement_s + r.timings.untangle_s +
+                    r.timings.quality_s + r.timings.other_orders_s + write_s,
                 std::string(to_string(r.method.method)).c_str(), r.plan.stats.concave_steps);
+    if (r.tries.size() > 1) {
+      std::printf("elimination orders tried:");
+      for (size_t i = 0; i < r.tries.size(); ++i) {
+        const OrderTry& t = r.tries[i];
+        std::printf("%s %s/%s ", i ? ";" : "", std::string(to_string(t.method)).c_str(),
+                    std::string(to_string(t.side_rule)).c_str());
+        if (t.status == StatusCode::ok)
+          std::printf("min %.4f, %d hexes <= 0", t.min_sj, t.nonpositive);
+        else
+          std::printf("%s", std::string(to_string(t.status)).c_str());
+        if (static_cast<int32_t>(i) == r.kept_try) std::printf(" (kept)");
+      }
+      std::printf("\n");
+    }
     std::printf("scaled Jacobian min %.4f mean %.4f max %.4f, %d hexes <= 0; "
                 "singular edges: %d interior, %d boundary\n",
                 q.sj_min, q.sj_mean, q.sj_max, q.sj_count_nonpositive, q.singular_edges_interior,
@@ -310,6 +328,14 @@ int main(int argc, char** argv) {
                    "untangling minimizer: lbfgs (L-BFGS) or newton (projected Newton with a "
                    "CHOLMOD sparse Cholesky; fewer, much costlier iterations) (default: lbfgs)")
       ->check(CLI::IsMember({"lbfgs", "newton"}))->capture_default_str();
+  mesh->add_option("--alternatives", params.alternatives,
+                   "other elimination orders tried when the mesh keeps hexes with scaled "
+                   "Jacobian <= 0 or elimination fails (the other side rule, the other method, "
+                   "both); the best mesh is kept; 0 = only the given order")
+      ->check(CLI::Range(0, 3))->capture_default_str();
+  mesh->add_flag("--alternatives-always", params.alternatives_always,
+                 "try the alternative orders even when the first mesh is valid and keep the one "
+                 "with the largest minimum scaled Jacobian (slower)");
   mesh->add_flag("-q,--quiet", quiet, "print only warnings and errors");
 
   auto* quality = app.add_subcommand("quality", "Report the quality of any hex mesh (.vtk .vtu .mesh .msh).");

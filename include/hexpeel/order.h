@@ -28,6 +28,7 @@ enum class SideRule : int8_t {
   cost,      ///< the side with fewer quads (fewer hexes) unless the other side's sharp weight is
              ///< larger by at least side_threshold; the chosen side's size also enters the key
 };
+std::string_view to_string(SideRule rule);
 
 struct OrderParams {
   Method method = Method::kremer;

@@ -27,11 +27,31 @@ struct MeshParams {
   PlacementParams placement;
   UntangleParams untangle;        ///< untangling and quality optimization, after placement
   QualityParams quality;
+  /// When the untangled mesh keeps hexes with SJ <= 0, or elimination gets stuck or meets an
+  /// invalid intrusion, other elimination orders are tried (alternative_orders: the other side rule,
+  /// then the other method, then both), at most this many (>= 0; 0 = only the given order).
+  /// The best result is kept (better_result); each try gets the planner's whole budget.
+  int alternatives = 3;
+  /// Try the alternatives even when the first mesh is valid and keep the best one (the largest
+  /// minimum scaled Jacobian): slower, sometimes better.
+  bool alternatives_always = false;
 };
 
 struct MeshTimings {
   double check_s = 0, elimination_s = 0, reconstruction_s = 0, placement_s = 0, quality_s = 0;
   double pillow_s = 0, untangle_s = 0;
+  double other_orders_s = 0;  ///< the tries of other elimination orders that were not kept
+};
+
+/// One elimination order the pipeline tried and what it gave.
+struct OrderTry {
+  Method method = Method::kremer;
+  SideRule side_rule = SideRule::cost;
+  StatusCode status = StatusCode::ok;
+  int32_t hexes = 0;        ///< when status ok
+  int32_t nonpositive = 0;  ///< hexes with SJ <= 0, when status ok
+  double min_sj = 0.0;      ///< when status ok
+  double seconds = 0.0;     ///< elimination to quality
 };
 
 struct MeshResult {
@@ -49,12 +69,24 @@ struct MeshResult {
   QuadSurface stuck_surface;     ///< when elimination got stuck: the surface it stopped at
   MeshTimings timings;
   OrderParams method;            ///< the elimination order (method and rules) this run used
+  std::vector<OrderTry> tries;   ///< every order tried, the given one first (empty when the
+                                 ///< input was rejected)
+  int32_t kept_try = 0;          ///< the try this result is
 };
+
+/// The elimination orders tried after `base` when its mesh is not valid, in order: base with the
+/// other side rule, base with the other method, base with both switched.
+std::vector<OrderParams> alternative_orders(const OrderParams& base);
+
+/// Whether a is better than b: a finished mesh before a failure, then fewer hexes with SJ <= 0,
+/// then the larger minimum scaled Jacobian; false on a tie (the earlier try stays).
+bool better_result(const MeshResult& a, const MeshResult& b);
 
 MeshResult run_mesh(const PolygonSoup& soup, const MeshParams& params = {}, const Context& ctx = {});
 
 /// The report: the quality JSON plus "status", "message", "input", "chords", "steps", "plan",
-/// "reconstruction", "pillow", "placement", "untangle", "timings_s", "method" {name, rules}.
+/// "reconstruction", "pillow", "placement", "untangle", "timings_s", "method" {name, side_rule,
+/// rules}, "orders_tried" [{method, side_rule, status, hexes, nonpositive, min_sj, seconds, kept}].
 nlohmann::json to_json(const MeshResult& result);
 
 }  // namespace hexpeel

@@ -34,30 +34,26 @@ HexMesh renumber(const HexMesh& mesh, const HexComplex& complex, int32_t surface
   return out;
 }
 
-}  // namespace
-
-MeshResult run_mesh(const PolygonSoup& soup, const MeshParams& params, const Context& ctx) {
+/// The stages after the input checks, with elimination order `order`; fills everything but
+/// `diagnosis`, `tries` and the check time.
+MeshResult mesh_with_order(const SurfaceDiagnosis& diagnosis, const MeshParams& params,
+                           const OrderParams& order, const Context& ctx) {
   MeshResult r;
-  r.method = params.elimination.order;
-  auto t = std::chrono::steady_clock::now();
-  r.diagnosis = diagnose_surface(soup, params.sharp_angle_deg, ctx, params.validation);
-  r.timings.check_s = seconds_since(t);
-  if (!r.diagnosis.status.ok()) {
-    r.status = r.diagnosis.status;
-    return r;
-  }
-  const QuadSurface& surface = r.diagnosis.validation.surface;
+  r.method = order;
+  const QuadSurface& surface = diagnosis.validation.surface;
 
-  t = std::chrono::steady_clock::now();
-  EliminationState state(surface, r.diagnosis.chords, r.diagnosis.edges);
+  auto t = std::chrono::steady_clock::now();
+  EliminationState state(surface, diagnosis.chords, diagnosis.edges);
   if (params.search) {
     PlannerParams pp = params.planner;
-    pp.order = params.elimination.order;
+    pp.order = order;
     PlannerResult pr = run_planner(state, pp, ctx);
     r.plan = std::move(pr.plan);
     r.planner = pr.stats;
   } else {
-    r.plan = run_elimination(state, params.elimination, ctx);
+    EliminationParams ep = params.elimination;
+    ep.order = order;
+    r.plan = run_elimination(state, ep, ctx);
   }
   r.timings.elimination_s = seconds_since(t);
   if (!r.plan.status.ok()) {
@@ -121,6 +117,105 @@ MeshResult run_mesh(const PolygonSoup& soup, const MeshParams& params, const Con
   return r;
 }
 
+/// Whether another elimination order may do better than r: its untangled mesh keeps hexes with
+/// SJ <= 0, or the order itself failed (stuck, or an intrusion that --strict-intrusion refuses).
+/// A placement that was not untangled is expected to keep inverted hexes.
+bool order_may_help(const MeshResult& r, const MeshParams& params) {
+  if (r.status.ok()) return params.untangle.untangle && r.quality.sj_count_nonpositive > 0;
+  return r.status.code == StatusCode::stuck || r.status.code == StatusCode::invalid_intrusion;
+}
+
+double total_seconds(const MeshTimings& t) {
+  return t.elimination_s + t.reconstruction_s + t.pillow_s + t.placement_s + t.untangle_s +
+         t.quality_s;
+}
+
+OrderTry summarize(const MeshResult& r, double seconds) {
+  OrderTry t;
+  t.method = r.method.method;
+  t.side_rule = r.method.side_rule;
+  t.status = r.status.code;
+  if (r.status.ok()) {
+    t.hexes = r.quality.hexes;
+    t.nonpositive = r.quality.sj_count_nonpositive;
+    t.min_sj = r.quality.sj_min;
+  }
+  t.seconds = seconds;
+  return t;
+}
+
+std::string describe(const OrderParams& o) {
+  return "method " + std::string(to_string(o.method)) + ", side rule " +
+         std::string(to_string(o.side_rule));
+}
+
+}  // namespace
+
+std::vector<OrderParams> alternative_orders(const OrderParams& base) {
+  auto other_rule = [](SideRule s) {
+    return s == SideRule::cost ? SideRule::heavier : SideRule::cost;
+  };
+  auto other_method = [](Method m) {
+    return m == Method::kremer ? Method::original : Method::kremer;
+  };
+  std::vector<OrderParams> out(3, base);
+  out[0].side_rule = other_rule(base.side_rule);
+  out[1].method = other_method(base.method);
+  out[2].side_rule = other_rule(base.side_rule);
+  out[2].method = other_method(base.method);
+  return out;
+}
+
+bool better_result(const MeshResult& a, const MeshResult& b) {
+  if (a.status.ok() != b.status.ok()) return a.status.ok();
+  if (!a.status.ok()) return false;
+  if (a.quality.sj_count_nonpositive != b.quality.sj_count_nonpositive)
+    return a.quality.sj_count_nonpositive < b.quality.sj_count_nonpositive;
+  return a.quality.sj_min > b.quality.sj_min;
+}
+
+MeshResult run_mesh(const PolygonSoup& soup, const MeshParams& params, const Context& ctx) {
+  auto t = std::chrono::steady_clock::now();
+  SurfaceDiagnosis diagnosis = diagnose_surface(soup, params.sharp_angle_deg, ctx, params.validation);
+  const double check_s = seconds_since(t);
+  if (!diagnosis.status.ok()) {
+    MeshResult r;
+    r.method = params.elimination.order;
+    r.status = diagnosis.status;
+    r.diagnosis = std::move(diagnosis);
+    r.timings.check_s = check_s;
+    return r;
+  }
+
+  t = std::chrono::steady_clock::now();
+  MeshResult best = mesh_with_order(diagnosis, params, params.elimination.order, ctx);
+  std::vector<OrderTry> tries{summarize(best, seconds_since(t))};
+  double others_s = 0.0;
+  const std::vector<OrderParams> alternatives = alternative_orders(params.elimination.order);
+  for (int i = 0; i < params.alternatives && i < static_cast<int>(alternatives.size()); ++i) {
+    if (!params.alternatives_always && !order_may_help(best, params)) break;
+    const char* why = !order_may_help(best, params) ? "looking for a better mesh"
+                      : best.status.ok()        ? "the mesh keeps hexes with scaled Jacobian <= 0"
+                                                : "elimination failed";
+    ctx.info(std::string(why) + ": trying elimination order " + describe(alternatives[i]));
+    t = std::chrono::steady_clock::now();
+    MeshResult r = mesh_with_order(diagnosis, params, alternatives[i], ctx);
+    tries.push_back(summarize(r, seconds_since(t)));
+    if (better_result(r, best)) {
+      others_s += total_seconds(best.timings);
+      best = std::move(r);
+      best.kept_try = static_cast<int32_t>(tries.size()) - 1;
+    } else {
+      others_s += total_seconds(r.timings);
+    }
+  }
+  best.tries = std::move(tries);
+  best.diagnosis = std::move(diagnosis);
+  best.timings.check_s = check_s;
+  best.timings.other_orders_s = others_s;
+  return best;
+}
+
 namespace {
 bool params_used_search(const MeshResult& r) { return r.planner.nodes > 0 || r.planner.plans_tried > 0; }
 }  // namespace
@@ -138,6 +233,7 @@ nlohmann::json to_json(const MeshResult& r) {
                  {"self_intersecting", cs.self_intersecting}};
   const OrderParams& order = r.method;
   j["method"] = {{"name", std::string(to_string(order.method))},
+                 {"side_rule", std::string(to_string(order.side_rule))},
                  {"rules",
                   order.method == Method::kremer
                       ? nlohmann::json{{"zero_volume", order.zero_volume},
@@ -149,6 +245,18 @@ nlohmann::json to_json(const MeshResult& r) {
                                        {"false_positive", order.false_positive},
                                        {"concave_waits_for_enclosed", order.concave_waits_for_enclosed}}
                       : nlohmann::json::object()}};
+  j["orders_tried"] = nlohmann::json::array();
+  for (size_t i = 0; i < r.tries.size(); ++i) {
+    const OrderTry& t = r.tries[i];
+    j["orders_tried"].push_back({{"method", std::string(to_string(t.method))},
+                                 {"side_rule", std::string(to_string(t.side_rule))},
+                                 {"status", std::string(to_string(t.status))},
+                                 {"hexes", t.hexes},
+                                 {"nonpositive", t.nonpositive},
+                                 {"min_sj", t.min_sj},
+                                 {"seconds", t.seconds},
+                                 {"kept", static_cast<int32_t>(i) == r.kept_try}});
+  }
   j["steps"] = r.plan.stats.steps;
   j["plan"] = {{"steps", r.plan.stats.steps},
                {"flat_steps", r.plan.stats.flat_steps},
@@ -248,7 +356,8 @@ nlohmann::json to_json(const MeshResult& r) {
                     {"pillow", r.timings.pillow_s},
                     {"placement", r.timings.placement_s},
                     {"untangle", r.timings.untangle_s},
-                    {"quality", r.timings.quality_s}};
+                    {"quality", r.timings.quality_s},
+                    {"other_orders", r.timings.other_orders_s}};
   return j;
 }
 

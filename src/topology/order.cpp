@@ -46,6 +46,14 @@ std::string_view to_string(Method method) {
   return "?";
 }
 
+std::string_view to_string(SideRule rule) {
+  switch (rule) {
+    case SideRule::heavier: return "heavier";
+    case SideRule::cost: return "cost";
+  }
+  return "?";
+}
+
 namespace {
 
 constexpr double kTierConvex = 1, kTierBothConvex = 2, kTierZeroVolume = 4, kTierWaits = 8,

@@ -13,6 +13,7 @@
 
 #include <cstring>
 #include <random>
+#include <set>
 
 namespace hexpeel {
 namespace {
@@ -560,6 +561,94 @@ TEST(GeometryPipeline, SaddleVerticesAreFittedAndAllPositive) {
   EXPECT_EQ(r.pillow.forced_after, 0);
   EXPECT_EQ(r.pillow.unserved_vertices, 0);
   EXPECT_TRUE(r.quality.is_ball);
+}
+
+// Seed 6's first order leaves a saddle whose copies end squeezed into a plane (one hex at SJ
+// -0.002 with every pillow pass); the pipeline then tries the other orders and keeps a valid mesh.
+// If a better pillow ever fixes the first order, this fixture no longer exercises the fallback.
+TEST(GeometryPipeline, OtherOrdersRescueAMeshTheFirstOrderLeavesInverted) {
+  const Generated g = testing::pillowed(testing::random_voxel_solid(6, 4, 12, 2), 6, 0.3);
+  MeshParams mp;
+  mp.untangle.morph_stages = 0;  // the continuation does not help here; skip its cost
+  MeshResult r = run_mesh(to_polygon_soup(g.surface), mp);
+  ASSERT_TRUE(r.status.ok()) << to_string(r.status);
+  ASSERT_GE(r.tries.size(), 2u);
+  EXPECT_EQ(r.tries[0].method, mp.elimination.order.method);
+  EXPECT_EQ(r.tries[0].side_rule, mp.elimination.order.side_rule);
+  EXPECT_GT(r.tries[0].nonpositive, 0);
+  ASSERT_GT(r.kept_try, 0);
+  EXPECT_EQ(r.tries[r.kept_try].method, r.method.method);
+  EXPECT_EQ(r.tries[r.kept_try].side_rule, r.method.side_rule);
+  EXPECT_EQ(r.tries[r.kept_try].hexes, r.quality.hexes);
+  EXPECT_EQ(r.quality.sj_count_nonpositive, 0);
+  EXPECT_GT(r.quality.sj_min, 0.1);
+  EXPECT_TRUE(r.quality.is_ball);
+  EXPECT_EQ(r.quality.boundary_matches_surface, true);
+  EXPECT_GT(r.timings.other_orders_s, 0.0);
+  const nlohmann::json j = to_json(r);
+  ASSERT_EQ(j["orders_tried"].size(), r.tries.size());
+  EXPECT_TRUE(j["orders_tried"][r.kept_try]["kept"].get<bool>());
+  EXPECT_FALSE(j["orders_tried"][0]["kept"].get<bool>());
+
+  // With no alternatives, the given order's mesh is what comes back.
+  mp.alternatives = 0;
+  MeshResult only = run_mesh(to_polygon_soup(g.surface), mp);
+  ASSERT_TRUE(only.status.ok());
+  EXPECT_EQ(only.tries.size(), 1u);
+  EXPECT_EQ(only.kept_try, 0);
+  EXPECT_EQ(only.quality.sj_count_nonpositive, r.tries[0].nonpositive);
+}
+
+TEST(GeometryPipeline, AlternativeOrdersAreTheOtherThree) {
+  for (Method m : {Method::kremer, Method::original})
+    for (SideRule s : {SideRule::cost, SideRule::heavier}) {
+      OrderParams base;
+      base.method = m;
+      base.side_rule = s;
+      base.side_threshold = 0.25;
+      const std::vector<OrderParams> alt = alternative_orders(base);
+      ASSERT_EQ(alt.size(), 3u);
+      std::set<std::pair<Method, SideRule>> seen{{m, s}};
+      for (const OrderParams& o : alt) {
+        EXPECT_TRUE(seen.insert({o.method, o.side_rule}).second);
+        EXPECT_EQ(o.side_threshold, 0.25);  // the other settings stay
+      }
+      EXPECT_EQ(alt[0].method, m);  // the side rule is switched first
+    }
+}
+
+TEST(GeometryPipeline, BetterResultRanksValidityThenInvertedThenMinimum) {
+  MeshResult failed, inverted, low, high;
+  failed.status = Status::error(StatusCode::stuck, "stuck");
+  inverted.quality.sj_count_nonpositive = 2;
+  inverted.quality.sj_min = -0.1;
+  low.quality.sj_min = 0.2;
+  high.quality.sj_min = 0.3;
+  EXPECT_TRUE(better_result(inverted, failed));
+  EXPECT_FALSE(better_result(failed, inverted));
+  EXPECT_FALSE(better_result(failed, failed));
+  EXPECT_TRUE(better_result(low, inverted));
+  EXPECT_TRUE(better_result(high, low));
+  EXPECT_FALSE(better_result(low, high));
+  EXPECT_FALSE(better_result(high, high));  // a tie keeps the earlier try
+}
+
+// --alternatives-always: every order is tried on a valid mesh and the best one is kept.
+TEST(GeometryPipeline, AlternativesAlwaysKeepsTheBestTry) {
+  const Generated g = testing::pillowed(testing::random_voxel_solid(2, 4, 12, 2), 2, 0.3);
+  MeshParams mp;
+  mp.alternatives_always = true;
+  mp.untangle.morph_stages = 0;  // keeps the test fast
+  MeshResult r = run_mesh(to_polygon_soup(g.surface), mp);
+  ASSERT_TRUE(r.status.ok()) << to_string(r.status);
+  ASSERT_EQ(r.tries.size(), 4u);
+  const OrderTry& kept = r.tries[r.kept_try];
+  EXPECT_DOUBLE_EQ(kept.min_sj, r.quality.sj_min);
+  for (const OrderTry& t : r.tries) {
+    if (t.status != StatusCode::ok) continue;
+    EXPECT_GE(t.nonpositive, kept.nonpositive);
+    if (t.nonpositive == kept.nonpositive) EXPECT_LE(t.min_sj, kept.min_sj);
+  }
 }
 
 // The fit on a small case by hand: a saddle-free cube pillowed whole keeps every hex (nothing to
