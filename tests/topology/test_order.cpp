@@ -209,6 +209,33 @@ TEST(Reconstruction, InvalidIntrusionIsReportedWithNoMesh) {
   EXPECT_GT(reported, 0);
 }
 
+// The pipeline's fallback: when the given order's intrusion is refused, other orders are tried
+// and the first that meshes is kept (no untangling here, so a valid result ends the search).
+TEST(Reconstruction, OtherOrdersGetPastARefusedIntrusion) {
+  OrderParams loose = kremer();
+  loose.concave_min = 1e-6;
+  loose.false_positive = false;
+  loose.concave_waits_for_enclosed = false;
+  int rescued = 0;
+  for (const char* shape : {"U", "L", "T", "stairs", "steps"}) {
+    ht::Generated g = ht::named_solid(shape, 2);
+    MeshParams strict = greedy_params(loose);
+    strict.reconstruction.fallback_to_extrusion = false;
+    strict.alternatives = 3;
+    MeshResult r = run_mesh(to_polygon_soup(g.surface), strict);
+    ASSERT_FALSE(r.tries.empty()) << g.name;
+    if (r.tries[0].status != StatusCode::invalid_intrusion) continue;
+    ASSERT_TRUE(r.status.ok()) << g.name << ": " << to_string(r.status);
+    ++rescued;
+    EXPECT_GT(r.kept_try, 0);
+    EXPECT_EQ(r.tries.size(), static_cast<size_t>(r.kept_try) + 1);  // stops at the first valid
+    EXPECT_EQ(r.tries.back().status, StatusCode::ok);
+    QualityReport q = run_quality(r.mesh, {}, &g.surface);
+    EXPECT_TRUE(q.is_ball && q.boundary_matches_surface == true) << g.name;
+  }
+  EXPECT_GT(rescued, 0);
+}
+
 TEST(Order, KremerOnVoxelSolidsMeshesWhatOriginalMeshes) {
   std::vector<ht::Generated> gs;
   for (const char* shape : {"L", "U", "T", "pocket", "notch", "stairs", "steps"})
