@@ -159,7 +159,9 @@ int cmd_mesh(const std::string& in, const std::string& out, const std::string& r
         const OrderTry& t = r.tries[i];
         std::printf("%s %s/%s ", i ? ";" : "", std::string(to_string(t.method)).c_str(),
                     std::string(to_string(t.side_rule)).c_str());
-        if (t.status == StatusCode::ok)
+        if (t.same_plan_as >= 0)
+          std::printf("same plan as try %d", t.same_plan_as + 1);
+        else if (t.status == StatusCode::ok)
           std::printf("min %.4f, %d hexes <= 0", t.min_sj, t.nonpositive);
         else
           std::printf("%s", std::string(to_string(t.status)).c_str());

@@ -52,6 +52,9 @@ struct OrderTry {
   int32_t nonpositive = 0;  ///< hexes with SJ <= 0, when status ok
   double min_sj = 0.0;      ///< when status ok
   double seconds = 0.0;     ///< elimination to quality
+  /// The earlier try whose elimination plan this order reproduced: its mesh would be the same,
+  /// so it was not built again (the outcome fields are copied from that try); -1 otherwise.
+  int32_t same_plan_as = -1;
 };
 
 struct MeshResult {
@@ -86,7 +89,8 @@ MeshResult run_mesh(const PolygonSoup& soup, const MeshParams& params = {}, cons
 
 /// The report: the quality JSON plus "status", "message", "input", "chords", "steps", "plan",
 /// "reconstruction", "pillow", "placement", "untangle", "timings_s", "method" {name, side_rule,
-/// rules}, "orders_tried" [{method, side_rule, status, hexes, nonpositive, min_sj, seconds, kept}].
+/// rules}, "orders_tried" [{method, side_rule, status, hexes, nonpositive, min_sj, seconds,
+/// same_plan_as, kept}].
 nlohmann::json to_json(const MeshResult& result);
 
 }  // namespace hexpeel

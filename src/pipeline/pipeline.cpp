@@ -34,10 +34,23 @@ HexMesh renumber(const HexMesh& mesh, const HexComplex& complex, int32_t surface
   return out;
 }
 
+/// A plan's identity: its steps' chords, sides and kinds (the same plan gives the same mesh).
+std::vector<int64_t> plan_key(const EliminationPlan& plan) {
+  std::vector<int64_t> key;
+  key.reserve(plan.steps.size());
+  for (const PlanStep& s : plan.steps)
+    key.push_back(static_cast<int64_t>(s.chord) * 4 + s.side * 2 + (s.concave ? 1 : 0));
+  return key;
+}
+
 /// The stages after the input checks, with elimination order `order`; fills everything but
-/// `diagnosis`, `tries` and the check time.
+/// `diagnosis`, `tries` and the check time. `plans` holds the keys of the plans meshed before;
+/// when this order plans one of them again, it stops after planning and `same_as` names it.
+/// This order's plan key is appended to `plans` ({-1} when planning failed).
 MeshResult mesh_with_order(const SurfaceDiagnosis& diagnosis, const MeshParams& params,
-                           const OrderParams& order, const Context& ctx) {
+                           const OrderParams& order, const Context& ctx,
+                           std::vector<std::vector<int64_t>>& plans, int32_t& same_as) {
+  same_as = -1;
   MeshResult r;
   r.method = order;
   const QuadSurface& surface = diagnosis.validation.surface;
@@ -57,10 +70,16 @@ MeshResult mesh_with_order(const SurfaceDiagnosis& diagnosis, const MeshParams& 
   }
   r.timings.elimination_s = seconds_since(t);
   if (!r.plan.status.ok()) {
+    plans.push_back({-1});  // no plan: matches no key
     r.status = r.plan.status;
     if (r.plan.status.code == StatusCode::stuck) r.stuck_surface = state.current_surface();
     return r;
   }
+  std::vector<int64_t> key = plan_key(r.plan);
+  for (size_t i = 0; i < plans.size() && same_as < 0; ++i)
+    if (plans[i] == key) same_as = static_cast<int32_t>(i);
+  plans.push_back(std::move(key));
+  if (same_as >= 0) return r;
 
   t = std::chrono::steady_clock::now();
   ReconstructionResult rec = run_reconstruction(surface, r.plan, params.reconstruction, ctx, &state);
@@ -188,7 +207,9 @@ MeshResult run_mesh(const PolygonSoup& soup, const MeshParams& params, const Con
   }
 
   t = std::chrono::steady_clock::now();
-  MeshResult best = mesh_with_order(diagnosis, params, params.elimination.order, ctx);
+  std::vector<std::vector<int64_t>> plans;
+  int32_t same_as = -1;
+  MeshResult best = mesh_with_order(diagnosis, params, params.elimination.order, ctx, plans, same_as);
   std::vector<OrderTry> tries{summarize(best, seconds_since(t))};
   double others_s = 0.0;
   const std::vector<OrderParams> alternatives = alternative_orders(params.elimination.order);
@@ -199,7 +220,17 @@ MeshResult run_mesh(const PolygonSoup& soup, const MeshParams& params, const Con
                                                 : "elimination failed";
     ctx.info(std::string(why) + ": trying elimination order " + describe(alternatives[i]));
     t = std::chrono::steady_clock::now();
-    MeshResult r = mesh_with_order(diagnosis, params, alternatives[i], ctx);
+    MeshResult r = mesh_with_order(diagnosis, params, alternatives[i], ctx, plans, same_as);
+    if (same_as >= 0) {  // the same mesh again: not built twice
+      OrderTry same = tries[same_as];
+      same.method = alternatives[i].method;
+      same.side_rule = alternatives[i].side_rule;
+      same.seconds = seconds_since(t);
+      same.same_plan_as = same_as;
+      tries.push_back(same);
+      others_s += r.timings.elimination_s;
+      continue;
+    }
     tries.push_back(summarize(r, seconds_since(t)));
     if (better_result(r, best)) {
       others_s += total_seconds(best.timings);
@@ -255,6 +286,7 @@ nlohmann::json to_json(const MeshResult& r) {
                                  {"nonpositive", t.nonpositive},
                                  {"min_sj", t.min_sj},
                                  {"seconds", t.seconds},
+                                 {"same_plan_as", t.same_plan_as},
                                  {"kept", static_cast<int32_t>(i) == r.kept_try}});
   }
   j["steps"] = r.plan.stats.steps;

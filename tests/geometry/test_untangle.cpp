@@ -617,6 +617,22 @@ TEST(GeometryPipeline, AlternativeOrdersAreTheOtherThree) {
     }
 }
 
+// On a cube grid every order plans the same: the alternatives are planned but not meshed again.
+TEST(GeometryPipeline, AnOrderThatRepeatsAPlanIsNotMeshedAgain) {
+  MeshParams mp;
+  mp.alternatives_always = true;
+  MeshResult r = run_mesh(to_polygon_soup(testing::cube(3, 3, 3).surface), mp);
+  ASSERT_TRUE(r.status.ok()) << to_string(r.status);
+  ASSERT_EQ(r.tries.size(), 4u);
+  EXPECT_EQ(r.tries[0].same_plan_as, -1);
+  EXPECT_EQ(r.kept_try, 0);
+  for (size_t i = 1; i < r.tries.size(); ++i) {
+    EXPECT_EQ(r.tries[i].same_plan_as, 0) << i;
+    EXPECT_EQ(r.tries[i].hexes, r.tries[0].hexes);
+  }
+  EXPECT_DOUBLE_EQ(r.quality.sj_min, 1.0);
+}
+
 TEST(GeometryPipeline, BetterResultRanksValidityThenInvertedThenMinimum) {
   MeshResult failed, inverted, low, high;
   failed.status = Status::error(StatusCode::stuck, "stuck");
@@ -645,6 +661,11 @@ TEST(GeometryPipeline, AlternativesAlwaysKeepsTheBestTry) {
   const OrderTry& kept = r.tries[r.kept_try];
   EXPECT_DOUBLE_EQ(kept.min_sj, r.quality.sj_min);
   for (const OrderTry& t : r.tries) {
+    if (t.same_plan_as >= 0) {  // a copy of an earlier try that was meshed
+      ASSERT_LT(t.same_plan_as, static_cast<int32_t>(&t - r.tries.data()));
+      EXPECT_EQ(r.tries[t.same_plan_as].same_plan_as, -1);
+      EXPECT_EQ(t.min_sj, r.tries[t.same_plan_as].min_sj);
+    }
     if (t.status != StatusCode::ok) continue;
     EXPECT_GE(t.nonpositive, kept.nonpositive);
     if (t.nonpositive == kept.nonpositive) EXPECT_LE(t.min_sj, kept.min_sj);
