@@ -103,10 +103,16 @@ struct UntangleParams {
   double regularization = 0.1;
   /// Phase 2 then runs local max-min sweeps: the free vertices of the local_hexes worst hexes,
   /// worst first, each moved by a pattern search whose steps never lower the minimum of its hexes
-  /// (sequential, deterministic; the global minimum never drops). At most local_sweeps sweeps
-  /// (0 skips them); they stop once a sweep moves nothing.
+  /// (sequential, deterministic; the global minimum never drops). With local_all, every other
+  /// free vertex follows (in parallel by colours: no two vertices of a colour share a hex, so the
+  /// result does not depend on the thread count); that mostly raises the mean. At most
+  /// local_sweeps sweeps (0 skips them); they stop once a sweep moves nothing.
   int local_sweeps = 3;
   int local_hexes = 200;
+  bool local_all = true;
+  /// The other vertices' searches stop at steps of this times their scale (the worst hexes'
+  /// at 1e-3): coarser, since they are for the mean (in (0, 0.1]).
+  double local_all_stop = 3e-2;
   /// A sweep step must keep the minimum of the vertex's hexes and raise that minimum plus this
   /// times their mean (>= 0): a pure max-min (0) sacrificed the other hexes (thin plate: mean
   /// 0.55 -> 0.33).

@@ -572,8 +572,11 @@ int32_t minimize_region(Problem& prob, Problem& sub, const std::vector<uint8_t>&
 /// minimum scaled Jacobian of the vertex's hexes and raises that minimum plus local_mean_weight
 /// times their mean; the step starts at a tenth of the vertex's mean distance to the other points
 /// of its hexes and halves when no direction helps, down to 1/1000 of it. The smoothed
-/// objectives spread their gradient over many corners; this one moves the worst hex's vertices
-/// directly. Sequential, so deterministic, and the global minimum never drops. Returns the moves.
+/// objectives spread their gradient over many corners; this one moves the worst hexes' vertices
+/// directly. With local_all, every other free vertex follows, in parallel by colours (no two
+/// vertices of a colour share a hex, so a vertex's search reads only hexes no other vertex of its
+/// colour touches): the result is the same for any thread count. The global minimum never drops.
+/// Returns the moves.
 int64_t local_max_min(const Problem& prob, std::vector<Vec3>& pts, const UntangleParams& params) {
   const std::vector<Hex>& hexes = prob.hexes;
   const int32_t nh = static_cast<int32_t>(hexes.size());
@@ -596,9 +599,11 @@ int64_t local_max_min(const Problem& prob, std::vector<Vec3>& pts, const Untangl
     }
     return std::pair<double, double>{m, sum / std::max<int32_t>(1, last(v) - first(v))};
   };
-  // A step must not lower the minimum and must raise minimum + local_mean_weight * mean.
-  auto score = [&](const std::pair<double, double>& q) {
-    return q.first + params.local_mean_weight * q.second;
+  // A step must not lower the minimum and must raise minimum + w * mean: w = local_mean_weight
+  // for the worst hexes' vertices; the other vertices' steps are for the mean alone (scoring
+  // their local minimum too lowered the mean).
+  auto score = [&](const std::pair<double, double>& q, double w) {
+    return w < 0 ? q.second : q.first + w * q.second;
   };
   static const std::array<Vec3, 14> dirs = [] {
     std::array<Vec3, 14> d;
@@ -609,7 +614,39 @@ int64_t local_max_min(const Problem& prob, std::vector<Vec3>& pts, const Untangl
       d[n++] = Vec3(m & 1 ? 1 : -1, m & 2 ? 1 : -1, m & 4 ? 1 : -1) / std::sqrt(3.0);
     return d;
   }();
+  // The pattern search of one vertex, down to steps of stop times its scale; returns its moves.
+  auto search = [&](int32_t v, double stop, double w) {
+    double len = 0.0;
+    int count = 0;
+    for (int32_t i = first(v); i < last(v); ++i)
+      for (int32_t w : hexes[prob.inc_slot[i] / 8])
+        if (w != v) len += (pts[w] - pts[v]).norm(), ++count;
+    const double l = count > 0 ? len / count : 0.0;
+    std::pair<double, double> cur = vertex_quality(v);
+    int32_t moved = 0;
+    double step = 0.1 * l;
+    for (int it = 0; it < 200 && step > stop * l; ++it) {
+      const Vec3 old = pts[v];
+      int best = -1;
+      std::pair<double, double> best_q = cur;
+      for (int d = 0; d < 14; ++d) {
+        pts[v] = old + step * dirs[d];
+        const std::pair<double, double> q = vertex_quality(v);
+        if (q.first >= cur.first && score(q, w) > score(best_q, w)) best_q = q, best = d;
+      }
+      pts[v] = best >= 0 ? Vec3(old + step * dirs[best]) : old;
+      if (best >= 0) {
+        cur = best_q;
+        ++moved;
+      } else {
+        step *= 0.5;
+      }
+    }
+    return moved;
+  };
   std::vector<double> sj(nh);
+  std::vector<int32_t> color(np, -1), moved;
+  std::vector<uint8_t> used, in_worst(np, 0);
   int64_t moves = 0;
   for (int sweep = 0; sweep < params.local_sweeps; ++sweep) {
     tbb::parallel_for(tbb::blocked_range<int32_t>(0, nh, 512),
@@ -622,40 +659,50 @@ int64_t local_max_min(const Problem& prob, std::vector<Vec3>& pts, const Untangl
     std::partial_sort(order.begin(), order.begin() + k, order.end(), [&](int32_t a, int32_t b) {
       return sj[a] != sj[b] ? sj[a] < sj[b] : a < b;
     });
-    std::vector<int32_t> verts;  // free vertices of the k worst hexes, worst hex first
-    std::vector<uint8_t> seen(np, 0);
+    // 1. The free vertices of the k worst hexes, worst hex first, one after the other: each sees
+    // the moves before it (moving them in parallel lowered the minimum on pierrot and screw2).
+    std::vector<int32_t> verts;
+    std::fill(in_worst.begin(), in_worst.end(), 0);
     for (int32_t i = 0; i < k; ++i)
       for (int32_t v : hexes[order[i]])
-        if (prob.free_index[v] >= 0 && !seen[v]) seen[v] = 1, verts.push_back(v);
-    const int64_t moves_before = moves;
-    for (int32_t v : verts) {
-      double len = 0.0;
-      int count = 0;
-      for (int32_t i = first(v); i < last(v); ++i)
-        for (int32_t w : hexes[prob.inc_slot[i] / 8])
-          if (w != v) len += (pts[w] - pts[v]).norm(), ++count;
-      const double l = count > 0 ? len / count : 0.0;
-      std::pair<double, double> cur = vertex_quality(v);
-      double step = 0.1 * l;
-      for (int it = 0; it < 200 && step > 1e-3 * l; ++it) {
-        const Vec3 old = pts[v];
-        int best = -1;
-        std::pair<double, double> best_q = cur;
-        for (int d = 0; d < 14; ++d) {
-          pts[v] = old + step * dirs[d];
-          const std::pair<double, double> q = vertex_quality(v);
-          if (q.first >= cur.first && score(q) > score(best_q)) best_q = q, best = d;
-        }
-        pts[v] = best >= 0 ? Vec3(old + step * dirs[best]) : old;
-        if (best >= 0) {
-          cur = best_q;
-          ++moves;
-        } else {
-          step *= 0.5;
-        }
+        if (prob.free_index[v] >= 0 && !in_worst[v]) in_worst[v] = 1, verts.push_back(v);
+    int64_t sweep_moves = 0;
+    for (int32_t v : verts) sweep_moves += search(v, 1e-3, params.local_mean_weight);
+    // 2. With local_all, every other free vertex, coloured greedily in id order so that no two of
+    // a colour share a hex; colour after colour, the vertices of a colour in parallel.
+    verts.clear();
+    if (params.local_all) {
+      std::fill(color.begin(), color.end(), -1);
+      int32_t colors = 0;
+      for (int32_t v = 0; v < np; ++v) {
+        if (prob.free_index[v] < 0 || in_worst[v]) continue;
+        used.assign(colors + 1, 0);
+        for (int32_t j = first(v); j < last(v); ++j)
+          for (int32_t w : hexes[prob.inc_slot[j] / 8])
+            if (color[w] >= 0) used[color[w]] = 1;
+        int32_t c = 0;
+        while (used[c]) ++c;
+        color[v] = c;
+        colors = std::max(colors, c + 1);
+        verts.push_back(v);
       }
+      std::stable_sort(verts.begin(), verts.end(),
+                       [&](int32_t a, int32_t b) { return color[a] < color[b]; });
     }
-    if (moves == moves_before) break;
+    moved.assign(verts.size(), 0);
+    for (size_t b = 0; b < verts.size();) {
+      size_t e = b;
+      while (e < verts.size() && color[verts[e]] == color[verts[b]]) ++e;
+      tbb::parallel_for(tbb::blocked_range<size_t>(b, e, 16),
+                        [&](const tbb::blocked_range<size_t>& r) {
+                          for (size_t i = r.begin(); i != r.end(); ++i)
+                            moved[i] = search(verts[i], params.local_all_stop, -1.0);
+                        });
+      b = e;
+    }
+    sweep_moves += std::accumulate(moved.begin(), moved.end(), int64_t{0});
+    moves += sweep_moves;
+    if (sweep_moves == 0) break;
   }
   return moves;
 }
