@@ -176,18 +176,25 @@ TEST(Reconstruction, IntrusionGivesABallWithTheInputBoundary) {
   }
 }
 
-TEST(Reconstruction, InvalidIntrusionIsReportedWithNoMesh) {
-  // With every concave edge counting and no 5.4 safeguards, a one-voxel-thick U gets a concave
-  // step whose side faces have no hex beneath: the intrusion must fail cleanly.
+/// Every concave edge counting and no 5.4 safeguards: greedy, with intrusions that cannot be
+/// done refused (no fallback to extrusion).
+MeshParams loose_strict_params() {
   OrderParams loose = kremer();
   loose.concave_min = 1e-6;
   loose.false_positive = false;
   loose.concave_waits_for_enclosed = false;
+  MeshParams strict = greedy_params(loose);
+  strict.reconstruction.fallback_to_extrusion = false;
+  return strict;
+}
+
+TEST(Reconstruction, InvalidIntrusionIsReportedWithNoMesh) {
+  // With every concave edge counting and no 5.4 safeguards, a one-voxel-thick U gets a concave
+  // step whose side faces have no hex beneath: the intrusion must fail cleanly.
   int reported = 0;
   for (const char* shape : {"U", "L", "T", "stairs", "steps"}) {
     ht::Generated g = ht::named_solid(shape, 2);
-    MeshParams strict = greedy_params(loose);
-    strict.reconstruction.fallback_to_extrusion = false;
+    const MeshParams strict = loose_strict_params();
     MeshResult r = run_mesh(to_polygon_soup(g.surface), strict);
     if (r.status.code != StatusCode::invalid_intrusion) {
       EXPECT_TRUE(r.status.ok() || r.status.code == StatusCode::stuck) << g.name << ": " << to_string(r.status);
@@ -198,7 +205,7 @@ TEST(Reconstruction, InvalidIntrusionIsReportedWithNoMesh) {
     EXPECT_NE(r.status.message.find("concave step"), std::string::npos) << r.status.message;
     EXPECT_FALSE(r.reconstruction.invalid_intrusion_steps.empty());
     // The same plan with the fallback: the step is extruded, the mesh is valid.
-    MeshParams fb = greedy_params(loose);
+    MeshParams fb = loose_strict_params();
     fb.reconstruction.fallback_to_extrusion = true;
     MeshResult f = run_mesh(to_polygon_soup(g.surface), fb);
     ASSERT_TRUE(f.status.ok()) << g.name << ": " << to_string(f.status);
@@ -212,15 +219,10 @@ TEST(Reconstruction, InvalidIntrusionIsReportedWithNoMesh) {
 // The pipeline's fallback: when the given order's intrusion is refused, other orders are tried
 // and the first that meshes is kept (no untangling here, so a valid result ends the search).
 TEST(Reconstruction, OtherOrdersGetPastARefusedIntrusion) {
-  OrderParams loose = kremer();
-  loose.concave_min = 1e-6;
-  loose.false_positive = false;
-  loose.concave_waits_for_enclosed = false;
   int rescued = 0;
   for (const char* shape : {"U", "L", "T", "stairs", "steps"}) {
     ht::Generated g = ht::named_solid(shape, 2);
-    MeshParams strict = greedy_params(loose);
-    strict.reconstruction.fallback_to_extrusion = false;
+    MeshParams strict = loose_strict_params();
     strict.alternatives = 3;
     MeshResult r = run_mesh(to_polygon_soup(g.surface), strict);
     ASSERT_FALSE(r.tries.empty()) << g.name;
