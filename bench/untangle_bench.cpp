@@ -29,7 +29,9 @@ namespace {
 
 using namespace hexpeel;
 
-void mesh_row(const std::string& name, const PolygonSoup& soup, const MeshParams& base) {
+void mesh_row(const std::string& name, const PolygonSoup& soup, const MeshParams& given) {
+  MeshParams base = given;
+  base.alternatives = 0;  // one order: the row compares its placement with its untangling
   MeshParams p0 = base;
   p0.untangle.untangle = p0.untangle.optimize = false;
   MeshResult r0 = run_mesh(soup, p0);

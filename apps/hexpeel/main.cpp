@@ -332,8 +332,9 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"lbfgs", "newton"}))->capture_default_str();
   mesh->add_option("--alternatives", params.alternatives,
                    "other elimination orders tried when the mesh keeps hexes with scaled "
-                   "Jacobian <= 0 or elimination fails (the other side rule, the other method, "
-                   "both); the best mesh is kept; 0 = only the given order")
+                   "Jacobian <= 0, or elimination gets stuck (not for lack of time) or an "
+                   "intrusion is refused (the other side rule, the other method, both; each with "
+                   "the whole plan budget); the best mesh is kept; 0 = only the given order")
       ->check(CLI::Range(0, 3))->capture_default_str();
   mesh->add_flag("--alternatives-always", params.alternatives_always,
                  "try the alternative orders even when the first mesh is valid and keep the one "

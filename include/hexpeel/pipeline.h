@@ -27,10 +27,11 @@ struct MeshParams {
   PlacementParams placement;
   UntangleParams untangle;        ///< untangling and quality optimization, after placement
   QualityParams quality;
-  /// When the untangled mesh keeps hexes with SJ <= 0, or elimination gets stuck or meets an
-  /// invalid intrusion, other elimination orders are tried (alternative_orders: the other side rule,
-  /// then the other method, then both), at most this many (>= 0; 0 = only the given order).
-  /// The best result is kept (better_result); each try gets the planner's whole budget.
+  /// When the untangled mesh keeps hexes with SJ <= 0, or elimination gets stuck (not for lack
+  /// of time) or meets an invalid intrusion, other elimination orders are tried
+  /// (alternative_orders: the other side rule, then the other method, then both), at most this
+  /// many (>= 0; 0 = only the given order). The best result is kept (better_result); each try
+  /// gets the planner's whole budget.
   int alternatives = 3;
   /// Try the alternatives even when the first mesh is valid and keep the best one (the largest
   /// minimum scaled Jacobian): slower, sometimes better.
@@ -40,7 +41,8 @@ struct MeshParams {
 struct MeshTimings {
   double check_s = 0, elimination_s = 0, reconstruction_s = 0, placement_s = 0, quality_s = 0;
   double pillow_s = 0, untangle_s = 0;
-  double other_orders_s = 0;  ///< the tries of other elimination orders that were not kept
+  double other_orders_s = 0;  ///< the tries that were not kept (the given order's too when
+                              ///< another was kept)
 };
 
 /// One elimination order the pipeline tried and what it gave.
@@ -48,7 +50,7 @@ struct OrderTry {
   Method method = Method::kremer;
   SideRule side_rule = SideRule::cost;
   StatusCode status = StatusCode::ok;
-  int32_t hexes = 0;        ///< when status ok
+  int32_t hexes = 0;        ///< when status ok (null in the JSON otherwise, as the next two)
   int32_t nonpositive = 0;  ///< hexes with SJ <= 0, when status ok
   double min_sj = 0.0;      ///< when status ok
   double seconds = 0.0;     ///< elimination to quality

@@ -105,8 +105,9 @@ struct UntangleParams {
   /// worst first, each moved by a pattern search whose steps never lower the minimum of its hexes
   /// (sequential, deterministic; the global minimum never drops). With local_all, every other
   /// free vertex follows (in parallel by colours: no two vertices of a colour share a hex, so the
-  /// result does not depend on the thread count); that mostly raises the mean. At most
-  /// local_sweeps sweeps (0 skips them); they stop once a sweep moves nothing.
+  /// result does not depend on the thread count); that mostly raises the mean (a mesh of at most
+  /// local_hexes hexes has no other vertices). At most local_sweeps sweeps (0 or local_hexes 0
+  /// skips them all); they stop once a sweep moves nothing.
   int local_sweeps = 3;
   int local_hexes = 200;
   bool local_all = true;

@@ -693,7 +693,7 @@ int64_t local_max_min(const Problem& prob, std::vector<Vec3>& pts, const Untangl
     for (size_t b = 0; b < verts.size();) {
       size_t e = b;
       while (e < verts.size() && color[verts[e]] == color[verts[b]]) ++e;
-      tbb::parallel_for(tbb::blocked_range<size_t>(b, e, 16),
+      tbb::parallel_for(tbb::blocked_range<size_t>(b, e, 4),
                         [&](const tbb::blocked_range<size_t>& r) {
                           for (size_t i = r.begin(); i != r.end(); ++i)
                             moved[i] = search(verts[i], params.local_all_stop, -1.0);

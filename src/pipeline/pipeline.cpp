@@ -138,10 +138,16 @@ MeshResult mesh_with_order(const SurfaceDiagnosis& diagnosis, const MeshParams& 
 
 /// Whether another elimination order may do better than r: its untangled mesh keeps hexes with
 /// SJ <= 0, or the order itself failed (stuck, or an intrusion that --strict-intrusion refuses).
-/// A placement that was not untangled is expected to keep inverted hexes.
+/// A placement that was not untangled is expected to keep inverted hexes. An order that ran out
+/// of its time (the planner's budget, greedy's time limit) ends the tries: the limit is the user's.
 bool order_may_help(const MeshResult& r, const MeshParams& params) {
   if (r.status.ok()) return params.untangle.untangle && r.quality.sj_count_nonpositive > 0;
-  return r.status.code == StatusCode::stuck || r.status.code == StatusCode::invalid_intrusion;
+  const bool out_of_time =
+      params.search ? r.planner.budget_exhausted
+                    : params.elimination.time_limit_s > 0 &&
+                          r.timings.elimination_s >= params.elimination.time_limit_s;
+  return !out_of_time &&
+         (r.status.code == StatusCode::stuck || r.status.code == StatusCode::invalid_intrusion);
 }
 
 double total_seconds(const MeshTimings& t) {
@@ -279,12 +285,13 @@ nlohmann::json to_json(const MeshResult& r) {
   j["orders_tried"] = nlohmann::json::array();
   for (size_t i = 0; i < r.tries.size(); ++i) {
     const OrderTry& t = r.tries[i];
+    const bool ok = t.status == StatusCode::ok;  // a failed try has no mesh to describe
     j["orders_tried"].push_back({{"method", std::string(to_string(t.method))},
                                  {"side_rule", std::string(to_string(t.side_rule))},
                                  {"status", std::string(to_string(t.status))},
-                                 {"hexes", t.hexes},
-                                 {"nonpositive", t.nonpositive},
-                                 {"min_sj", t.min_sj},
+                                 {"hexes", ok ? nlohmann::json(t.hexes) : nlohmann::json()},
+                                 {"nonpositive", ok ? nlohmann::json(t.nonpositive) : nlohmann::json()},
+                                 {"min_sj", ok ? nlohmann::json(t.min_sj) : nlohmann::json()},
                                  {"seconds", t.seconds},
                                  {"same_plan_as", t.same_plan_as},
                                  {"kept", static_cast<int32_t>(i) == r.kept_try}});

@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
+#include <tbb/task_arena.h>
 
 #include <cstring>
 #include <random>
@@ -359,6 +360,29 @@ TEST(GeometryUntangle, SameBytesForAnyThreadCount) {
   }
 }
 
+// The coloured sweep over all vertices: colour groups big enough to split across threads (a
+// larger sphere, 5 worst hexes swept first, so nearly every vertex is in a colour group), the
+// same bytes with 1 thread as with 4.
+TEST(GeometryUntangle, ColouredSweepIsTheSameForAnyThreadCount) {
+  Generated g = testing::jittered(testing::cubed_sphere_equiangular(8), 5, 0.3);
+  UntangleParams p;
+  p.local_hexes = 5;
+  // Allow 4 threads even on fewer cores, so the groups really are split.
+  tbb::global_control gc(tbb::global_control::max_allowed_parallelism, 4);
+  auto run = [&](int threads) {
+    tbb::task_arena arena(threads);
+    UntangleResult r;
+    arena.execute([&] { r = run_untangle(g.known_mesh, surface_fixed(g), p); });
+    return r;
+  };
+  UntangleResult a = run(1), b = run(4);
+  EXPECT_GT(a.stats.local_moves, 100);
+  EXPECT_EQ(a.stats.local_moves, b.stats.local_moves);
+  ASSERT_EQ(a.mesh.points.size(), b.mesh.points.size());
+  EXPECT_EQ(std::memcmp(a.mesh.points.data(), b.mesh.points.data(),
+                        a.mesh.points.size() * sizeof(Vec3)), 0);
+}
+
 TEST(GeometryUntangle, OptimizeNeverLowersTheMinimum) {
   Generated g = testing::jittered(testing::cubed_sphere_equiangular(4), 5, 0.2);
   UntangleParams p;
@@ -419,9 +443,6 @@ Generated flat_doublet() {
   return g;
 }
 
-// Exact inward-direction test: a convex corner has one, a saddle with opposite normals has none,
-// and a star whose best direction is fixed by three normals (the mean, each normal and each pair
-// fail) has one.
 // local_all: after the worst hexes' vertices, every other free vertex is swept (in parallel by
 // colours); that raises the mean, and no hex may end <= 0.
 TEST(GeometryPipeline, SweepsOverAllVerticesRaiseTheMean) {
@@ -441,6 +462,9 @@ TEST(GeometryPipeline, SweepsOverAllVerticesRaiseTheMean) {
   EXPECT_EQ(b.quality.boundary_matches_surface, true);
 }
 
+// Exact inward-direction test: a convex corner has one, a saddle with opposite normals has none,
+// and a star whose best direction is fixed by three normals (the mean, each normal and each pair
+// fail) has one.
 TEST(GeometryPillow, InwardDirectionIsExact) {
   EXPECT_TRUE(has_inward_direction({Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)}, 1e-3));
   EXPECT_FALSE(has_inward_direction({Vec3(1, 0, 0), Vec3(-1, 0, 0), Vec3(0, 0, 1)}, 1e-3));
@@ -616,6 +640,20 @@ TEST(GeometryPipeline, OtherOrdersRescueAMeshTheFirstOrderLeavesInverted) {
   EXPECT_EQ(only.tries.size(), 1u);
   EXPECT_EQ(only.kept_try, 0);
   EXPECT_EQ(only.quality.sj_count_nonpositive, r.tries[0].nonpositive);
+}
+
+// Running out of time is the user's limit, not the order's fault: no other order is tried.
+TEST(GeometryPipeline, AnOrderOutOfTimeEndsTheTries) {
+  MeshParams mp;
+  mp.search = false;
+  mp.elimination.time_limit_s = 1e-9;
+  MeshResult r = run_mesh(to_polygon_soup(testing::cubed_sphere_equiangular(6).surface), mp);
+  EXPECT_EQ(r.status.code, StatusCode::stuck) << to_string(r.status);
+  EXPECT_EQ(r.tries.size(), 1u);
+  const nlohmann::json j = to_json(r);
+  ASSERT_EQ(j["orders_tried"].size(), 1u);
+  EXPECT_TRUE(j["orders_tried"][0]["hexes"].is_null());  // a failed try has no mesh
+  EXPECT_TRUE(j["orders_tried"][0]["min_sj"].is_null());
 }
 
 TEST(GeometryPipeline, AlternativeOrdersAreTheOtherThree) {
