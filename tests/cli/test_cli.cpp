@@ -374,6 +374,31 @@ TEST_F(Cli, MeshWritesMeshAndReport) {
   for (const char* k : {"read", "check", "elimination", "reconstruction", "placement", "write"})
     EXPECT_TRUE(j.at("timings_s").contains(k)) << k;
   EXPECT_EQ(listing(), (std::vector<std::string>{"cube2.obj", "out.vtk", "report.json"}));
+  // One order was tried, and it is the one the report names.
+  ASSERT_EQ(j.at("orders_tried").size(), 1u);
+  EXPECT_TRUE(j.at("orders_tried")[0].at("kept").get<bool>());
+  EXPECT_EQ(j.at("orders_tried")[0].at("method"), j.at("method").at("name"));
+  EXPECT_EQ(j.at("orders_tried")[0].at("side_rule"), j.at("method").at("side_rule"));
+}
+
+// --no-mean-sweep: the sweep over every interior vertex is skipped (fewer local moves, a lower
+// mean); --alternatives is range-checked.
+TEST_F(Cli, MeanSweepCanBeSkipped) {
+  const std::string in =
+      write("rvox.obj", gen::pillowed(gen::random_voxel_solid(3, 4, 12, 2), 3, 0.3).surface);
+  Outcome a = run({"mesh", in, "-o", path("a.vtk"), "--report", path("a.json"), "--quiet"});
+  Outcome b = run({"mesh", in, "-o", path("b.vtk"), "--report", path("b.json"), "--quiet",
+                   "--no-mean-sweep"});
+  ASSERT_EQ(a.exit_code, 0) << a.err;
+  ASSERT_EQ(b.exit_code, 0) << b.err;
+  const auto ja = nlohmann::json::parse(slurp(path("a.json")));
+  const auto jb = nlohmann::json::parse(slurp(path("b.json")));
+  EXPECT_GT(ja.at("untangle").at("local_moves").get<int64_t>(),
+            jb.at("untangle").at("local_moves").get<int64_t>());
+  EXPECT_NE(slurp(path("a.vtk")), slurp(path("b.vtk")));
+  Outcome bad = run({"mesh", in, "-o", path("c.vtk"), "--alternatives", "4"});
+  EXPECT_EQ(bad.exit_code, 1) << bad.err;
+  EXPECT_FALSE(fs::exists(path("c.vtk")));
 }
 
 // A pillowed voxel solid whose reconstruction has hexes lying flat in the boundary (all 8
