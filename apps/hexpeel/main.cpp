@@ -322,7 +322,7 @@ int main(int argc, char** argv) {
   mesh->add_flag("--no-optimize", no_optimize,
                  "skip the scaled-Jacobian optimization after untangling (default: optimize)");
   mesh->add_option("--polish-iterations", params.untangle.max_mean_inner,
-                   "L-BFGS iterations of the mean polish that ends the optimization (raises the "
+                   "L-BFGS iterations of the mean polish near the end of the optimization (raises the "
                    "mean scaled Jacobian and never lowers the minimum; 0 = skip it, for speed)")
       ->check(CLI::Range(0, 100000))->capture_default_str();
   bool no_mean_sweep = false;
