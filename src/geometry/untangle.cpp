@@ -600,10 +600,11 @@ int64_t local_max_min(const Problem& prob, std::vector<Vec3>& pts, const Untangl
     return std::pair<double, double>{m, sum / std::max<int32_t>(1, last(v) - first(v))};
   };
   // A step must not lower the minimum and must raise minimum + w * mean: w = local_mean_weight
-  // for the worst hexes' vertices; the other vertices' steps are for the mean alone (scoring
-  // their local minimum too lowered the mean).
+  // for the worst hexes' vertices; the other vertices' steps are for the mean alone (kMeanOnly:
+  // scoring their local minimum too lowered the mean).
+  constexpr double kMeanOnly = -1.0;
   auto score = [&](const std::pair<double, double>& q, double w) {
-    return w < 0 ? q.second : q.first + w * q.second;
+    return w == kMeanOnly ? q.second : q.first + w * q.second;
   };
   static const std::array<Vec3, 14> dirs = [] {
     std::array<Vec3, 14> d;
@@ -619,8 +620,8 @@ int64_t local_max_min(const Problem& prob, std::vector<Vec3>& pts, const Untangl
     double len = 0.0;
     int count = 0;
     for (int32_t i = first(v); i < last(v); ++i)
-      for (int32_t w : hexes[prob.inc_slot[i] / 8])
-        if (w != v) len += (pts[w] - pts[v]).norm(), ++count;
+      for (int32_t u : hexes[prob.inc_slot[i] / 8])
+        if (u != v) len += (pts[u] - pts[v]).norm(), ++count;
     const double l = count > 0 ? len / count : 0.0;
     std::pair<double, double> cur = vertex_quality(v);
     int32_t moved = 0;
@@ -696,7 +697,7 @@ int64_t local_max_min(const Problem& prob, std::vector<Vec3>& pts, const Untangl
       tbb::parallel_for(tbb::blocked_range<size_t>(b, e, 4),
                         [&](const tbb::blocked_range<size_t>& r) {
                           for (size_t i = r.begin(); i != r.end(); ++i)
-                            moved[i] = search(verts[i], params.local_all_stop, -1.0);
+                            moved[i] = search(verts[i], params.local_all_stop, kMeanOnly);
                         });
       b = e;
     }
