@@ -22,6 +22,10 @@ namespace hexpeel {
 /// (Verdict returns VERDICT_DBL_MAX; we count those as <= 0). Otherwise the value is in [-1, 1].
 inline constexpr double kDegenerateScaledJacobian = -2.0;
 double scaled_jacobian(const std::array<Vec3, 8>& corners);
+/// One of the nine terms whose minimum scaled_jacobian is: term 0 is the centre (principal
+/// axes), term 1 + c corner c (kHexCornerFrames[c]); kDegenerateScaledJacobian when one of its
+/// columns has zero length. So scaled_jacobian is exactly the minimum of the nine terms.
+double scaled_jacobian_term(const std::array<Vec3, 8>& corners, int term);
 
 struct QualityParams {
   int histogram_bins = 20;   ///< bins over [-1, 1] (1..1000)

@@ -589,11 +589,35 @@ int64_t local_max_min(const Problem& prob, std::vector<Vec3>& pts, const Untangl
     for (int k = 0; k < 8; ++k) c[k] = pts[hexes[h][k]];
     return scaled_jacobian(c);
   };
-  // (min, mean) of the scaled Jacobians of v's hexes
-  auto vertex_quality = [&](int32_t v) {
+  // While v moves, only 5 of a hex's 9 scaled Jacobian terms change: the centre, v's corner
+  // and the corners of its 3 edge neighbours. rest[i - first(v)] holds the minimum of the other
+  // 4 for v's hex slot i (a degenerate term is -2, below any value, so for finite points the
+  // minimum keeps it and equals scaled_jacobian exactly).
+  auto rest_terms = [&](int32_t v, std::vector<double>& rest) {
+    rest.resize(last(v) - first(v));
+    for (int32_t i = first(v); i < last(v); ++i) {
+      const int k = prob.inc_slot[i] % 8;
+      const auto& nb = kHexCornerFrames[k];
+      std::array<Vec3, 8> c;
+      for (int j = 0; j < 8; ++j) c[j] = pts[hexes[prob.inc_slot[i] / 8][j]];
+      double m = std::numeric_limits<double>::infinity();
+      for (int corner = 0; corner < 8; ++corner)
+        if (corner != k && corner != nb[0] && corner != nb[1] && corner != nb[2])
+          m = std::min(m, scaled_jacobian_term(c, 1 + corner));
+      rest[i - first(v)] = m;
+    }
+  };
+  // (min, mean) of the scaled Jacobians of v's hexes, given rest_terms(v)
+  auto vertex_quality = [&](int32_t v, const std::vector<double>& rest) {
     double m = std::numeric_limits<double>::infinity(), sum = 0.0;
     for (int32_t i = first(v); i < last(v); ++i) {
-      const double q = hex_sj(prob.inc_slot[i] / 8);
+      const int k = prob.inc_slot[i] % 8;
+      const auto& nb = kHexCornerFrames[k];
+      std::array<Vec3, 8> c;
+      for (int j = 0; j < 8; ++j) c[j] = pts[hexes[prob.inc_slot[i] / 8][j]];
+      double q = rest[i - first(v)];
+      for (int term : {0, 1 + k, 1 + nb[0], 1 + nb[1], 1 + nb[2]})
+        q = std::min(q, scaled_jacobian_term(c, term));
       m = std::min(m, q);
       sum += q;
     }
@@ -623,7 +647,9 @@ int64_t local_max_min(const Problem& prob, std::vector<Vec3>& pts, const Untangl
       for (int32_t u : hexes[prob.inc_slot[i] / 8])
         if (u != v) len += (pts[u] - pts[v]).norm(), ++count;
     const double l = count > 0 ? len / count : 0.0;
-    std::pair<double, double> cur = vertex_quality(v);
+    std::vector<double> rest;
+    rest_terms(v, rest);
+    std::pair<double, double> cur = vertex_quality(v, rest);
     int32_t moved = 0;
     double step = 0.1 * l;
     for (int it = 0; it < 200 && step > stop * l; ++it) {
@@ -632,7 +658,7 @@ int64_t local_max_min(const Problem& prob, std::vector<Vec3>& pts, const Untangl
       std::pair<double, double> best_q = cur;
       for (int d = 0; d < 14; ++d) {
         pts[v] = old + step * dirs[d];
-        const std::pair<double, double> q = vertex_quality(v);
+        const std::pair<double, double> q = vertex_quality(v, rest);
         if (q.first >= cur.first && score(q, w) > score(best_q, w)) best_q = q, best = d;
       }
       pts[v] = best >= 0 ? Vec3(old + step * dirs[best]) : old;

@@ -38,21 +38,28 @@ bool normalized_jacobian(const Vec3& a, const Vec3& b, const Vec3& c, double& va
 
 }  // namespace
 
-double scaled_jacobian(const std::array<Vec3, 8>& p) {
-  // Principal axes: edges along parametric x (0->1, 3->2, 4->5, 7->6), y (0->3, 1->2, 4->7,
-  // 5->6) and z (0->4, 1->5, 2->6, 3->7), summed.
-  const Vec3 x1 = (p[1] + p[2] + p[5] + p[6]) - (p[0] + p[3] + p[4] + p[7]);
-  const Vec3 x2 = (p[2] + p[3] + p[6] + p[7]) - (p[0] + p[1] + p[4] + p[5]);
-  const Vec3 x3 = (p[4] + p[5] + p[6] + p[7]) - (p[0] + p[1] + p[2] + p[3]);
-
-  double lowest = kVerdictDblMax;
+double scaled_jacobian_term(const std::array<Vec3, 8>& p, int term) {
   double value = 0.0;
-  if (!normalized_jacobian(x1, x2, x3, value)) return kDegenerateScaledJacobian;
-  if (value < lowest) lowest = value;
-  for (int c = 0; c < 8; ++c) {
-    const auto& f = kHexCornerFrames[c];
-    if (!normalized_jacobian(p[f[0]] - p[c], p[f[1]] - p[c], p[f[2]] - p[c], value))
-      return kDegenerateScaledJacobian;
+  if (term == 0) {
+    // Principal axes: edges along parametric x (0->1, 3->2, 4->5, 7->6), y (0->3, 1->2, 4->7,
+    // 5->6) and z (0->4, 1->5, 2->6, 3->7), summed.
+    const Vec3 x1 = (p[1] + p[2] + p[5] + p[6]) - (p[0] + p[3] + p[4] + p[7]);
+    const Vec3 x2 = (p[2] + p[3] + p[6] + p[7]) - (p[0] + p[1] + p[4] + p[5]);
+    const Vec3 x3 = (p[4] + p[5] + p[6] + p[7]) - (p[0] + p[1] + p[2] + p[3]);
+    return normalized_jacobian(x1, x2, x3, value) ? value : kDegenerateScaledJacobian;
+  }
+  const int c = term - 1;
+  const auto& f = kHexCornerFrames[c];
+  return normalized_jacobian(p[f[0]] - p[c], p[f[1]] - p[c], p[f[2]] - p[c], value)
+             ? value
+             : kDegenerateScaledJacobian;
+}
+
+double scaled_jacobian(const std::array<Vec3, 8>& p) {
+  double lowest = kVerdictDblMax;
+  for (int term = 0; term < 9; ++term) {
+    const double value = scaled_jacobian_term(p, term);
+    if (value == kDegenerateScaledJacobian) return kDegenerateScaledJacobian;
     if (value < lowest) lowest = value;
   }
   if (lowest >= kVerdictDblMax) return kDegenerateScaledJacobian;

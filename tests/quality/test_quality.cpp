@@ -183,6 +183,36 @@ TEST(ScaledJacobian, NonFiniteCornerGivesNoValueBelowVerdictsStart) {
   EXPECT_EQ(scaled_jacobian(c), kDegenerateScaledJacobian);
 }
 
+TEST(ScaledJacobian, TermsAreTheNineJacobiansAndTheirMinimumIsTheValue) {
+  // scaled_jacobian_term(c, 0) is the centre, (c, 1 + k) corner k; the local sweeps rely on the
+  // minimum of the nine terms being bit for bit scaled_jacobian.
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> jitter(-0.45, 0.45);
+  int inverted = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    Corners c = unit_cube();
+    for (Vec3& p : c) p += Vec3(jitter(rng), jitter(rng), jitter(rng));
+    const auto corners = corner_values(c);
+    EXPECT_NEAR(scaled_jacobian_term(c, 0), centre_value(c), 1e-14);
+    double lowest = scaled_jacobian_term(c, 0);
+    for (int k = 0; k < 8; ++k) {
+      EXPECT_NEAR(scaled_jacobian_term(c, 1 + k), corners[k], 1e-14) << "corner " << k;
+      lowest = std::min(lowest, scaled_jacobian_term(c, 1 + k));
+    }
+    EXPECT_EQ(lowest, scaled_jacobian(c));
+    inverted += lowest <= 0.0;
+  }
+  EXPECT_GT(inverted, 10);  // the jitter makes both signs
+  // A zero-length edge makes only the terms that use it degenerate.
+  Corners d = unit_cube();
+  d[5] = d[4];  // edge 4-5: corners 4 and 5 use it, the centre and the other corners do not
+  EXPECT_EQ(scaled_jacobian_term(d, 1 + 4), kDegenerateScaledJacobian);
+  EXPECT_EQ(scaled_jacobian_term(d, 1 + 5), kDegenerateScaledJacobian);
+  EXPECT_NE(scaled_jacobian_term(d, 1 + 0), kDegenerateScaledJacobian);
+  EXPECT_NE(scaled_jacobian_term(d, 0), kDegenerateScaledJacobian);
+  EXPECT_EQ(scaled_jacobian(d), kDegenerateScaledJacobian);
+}
+
 TEST(Report, DegenerateHexIsCountedNonpositive) {
   HexMesh m = grid(2, 1, 1);
   m.points[m.hexes[1][5]] = m.points[m.hexes[1][4]];  // collapse edge 4-5 of hex 1
