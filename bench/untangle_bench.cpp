@@ -5,7 +5,7 @@
 //       full pipeline on each surface file (and with --family on generated surfaces): hexes,
 //       forced configurations, min/mean SJ after placement and after each phase, times.
 //   hexpeel_untangle_bench scaling [--sizes 10,22,46] [--threads N] [--solver newton|lbfgs]
-//                                  [--simplicial]
+//                                  [--simplicial] [--no-mean-sweep]
 //       the optimizer alone on jittered equiangular cubed spheres of n^3 hexes: time per phase,
 //       iterations / evaluations (Newton: also factorizations and the time spent assembling,
 //       factorizing and solving), corner-evaluations per second (one corner term with its
@@ -80,10 +80,11 @@ int main(int argc, char** argv) {
   scaling->add_option("--threads", threads, "TBB threads (0 = default)");
   scaling->add_option("--jitter", jitter, "jittered() amount")->capture_default_str();
   std::string solver = "lbfgs";
-  bool simplicial = false;
+  bool simplicial = false, no_mean_sweep = false;
   for (auto* sub : {mesh, scaling}) {
     sub->add_option("--solver", solver, "phase 1 minimizer: newton|lbfgs")->capture_default_str();
     sub->add_flag("--simplicial", simplicial, "Newton: CHOLMOD simplicial instead of supernodal");
+    sub->add_flag("--no-mean-sweep", no_mean_sweep, "UntangleParams::local_all = false");
   }
   CLI11_PARSE(app, argc, argv);
   UntangleParams up;
@@ -92,6 +93,7 @@ int main(int argc, char** argv) {
     return 1;
   }
   up.supernodal = !simplicial;
+  up.local_all = !no_mean_sweep;
   std::unique_ptr<tbb::global_control> gc;
   if (threads > 0)
     gc = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);

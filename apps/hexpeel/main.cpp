@@ -8,8 +8,8 @@
 //                [--no-false-positive] [--no-concave-waits] [--strict-intrusion]
 //                [--pillow auto|all|none] [--no-untangle] [--no-optimize]
 //                [--polish-iterations N] [--no-mean-sweep] [--solver lbfgs|newton] [--alternatives N]
-//                [--alternatives-always] [--quiet]
-//   hexpeel quality MESH [--surface IN] [--json FILE]
+//                [--alternatives-always] [--threads N] [--quiet]
+//   hexpeel quality MESH [--surface IN] [--json FILE] [--threads N]
 //
 // Exit codes: 0 success, 1 usage error, 2 bad input or file problem (for `quality`: also a mesh
 // with hexes of scaled Jacobian <= 0, not a ball, or not bounded by --surface), 3 meshing failed,
@@ -21,11 +21,13 @@
 #include "hexpeel/quality.h"
 
 #include <CLI/CLI.hpp>
+#include <tbb/global_control.h>
 
 #include <chrono>
 #include <cstdio>
 #include <exception>
 #include <iostream>
+#include <memory>
 #include <string>
 #include <unistd.h>
 
@@ -343,12 +345,17 @@ int main(int argc, char** argv) {
   mesh->add_flag("--alternatives-always", params.alternatives_always,
                  "try the alternative orders even when the first mesh is valid and keep the one "
                  "with the largest minimum scaled Jacobian (slower)");
+  int threads = 0;
+  const std::string threads_help =
+      "worker threads (0 = one per core); the output is the same for any count";
+  mesh->add_option("--threads", threads, threads_help)->check(CLI::Range(0, 1024))->capture_default_str();
   mesh->add_flag("-q,--quiet", quiet, "print only warnings and errors");
 
   auto* quality = app.add_subcommand("quality", "Report the quality of any hex mesh (.vtk .vtu .mesh .msh).");
   quality->add_option("MESH", in, "hex mesh file")->required();
   quality->add_option("--surface", surface, "also check that the mesh boundary equals this surface");
   quality->add_option("--json", json_out, "also write the report as JSON");
+  quality->add_option("--threads", threads, threads_help)->check(CLI::Range(0, 1024))->capture_default_str();
 
   try {
     app.parse(argc, argv);
@@ -358,6 +365,10 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "hexpeel: error: %s\n\n%s", e.what(), app.help().c_str());
     return 1;
   }
+  std::unique_ptr<tbb::global_control> thread_limit;
+  if (threads > 0)
+    thread_limit = std::make_unique<tbb::global_control>(
+        tbb::global_control::max_allowed_parallelism, static_cast<size_t>(threads));
   try {
     if (*check) return cmd_check(in, sharp_angle, json_out);
     if (*mesh) {

@@ -433,6 +433,32 @@ TEST_F(Cli, MeshIsDeterministic) {
   }
 }
 
+TEST_F(Cli, ThreadCountDoesNotChangeTheOutput) {
+  // Big enough (about 2k hexes) for the parallel loops to split the work.
+  const std::string in = write("sphere.obj", gen::cubed_sphere_equiangular(6).surface);
+  Outcome a = run({"mesh", in, "-o", path("a.vtk"), "--report", path("a.json"), "--quiet"});
+  Outcome b = run({"mesh", in, "-o", path("b.vtk"), "--report", path("b.json"), "--quiet",
+                   "--threads", "1"});
+  Outcome c = run({"mesh", in, "-o", path("c.vtk"), "--quiet", "--threads", "3"});
+  ASSERT_EQ(a.exit_code, 0) << a.err;
+  ASSERT_EQ(b.exit_code, 0) << b.err;
+  ASSERT_EQ(c.exit_code, 0) << c.err;
+  EXPECT_FALSE(slurp(path("a.vtk")).empty());
+  EXPECT_TRUE(slurp(path("a.vtk")) == slurp(path("b.vtk")));
+  EXPECT_TRUE(slurp(path("a.vtk")) == slurp(path("c.vtk")));
+  const auto ja = nlohmann::json::parse(slurp(path("a.json")));
+  const auto jb = nlohmann::json::parse(slurp(path("b.json")));
+  EXPECT_EQ(ja.at("scaled_jacobian"), jb.at("scaled_jacobian"));
+  Outcome qa = run({"quality", path("a.vtk"), "--json", path("qa.json")});
+  Outcome qb = run({"quality", path("a.vtk"), "--json", path("qb.json"), "--threads", "1"});
+  EXPECT_EQ(qa.exit_code, 0) << qa.err;
+  EXPECT_EQ(qb.exit_code, 0) << qb.err;
+  EXPECT_EQ(slurp(path("qa.json")), slurp(path("qb.json")));
+  Outcome bad = run({"mesh", in, "-o", path("d.vtk"), "--threads", "-1"});
+  EXPECT_EQ(bad.exit_code, 1) << bad.err;
+  EXPECT_FALSE(fs::exists(path("d.vtk")));
+}
+
 TEST_F(Cli, FailedMeshLeavesNoFileBehind) {
   // bad input
   const std::string bad = write("torus.obj", obj_text(test::torus_soup(8, 4)));
