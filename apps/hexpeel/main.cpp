@@ -347,7 +347,8 @@ int main(int argc, char** argv) {
                  "with the largest minimum scaled Jacobian (slower)");
   int threads = 0;
   const std::string threads_help =
-      "worker threads (0 = one per core); the output is the same for any count";
+      "at most this many threads for the parallel loops (0 = one per core); the output is the "
+      "same for any count";
   mesh->add_option("--threads", threads, threads_help)->check(CLI::Range(0, 1024))->capture_default_str();
   mesh->add_flag("-q,--quiet", quiet, "print only warnings and errors");
 

@@ -591,8 +591,8 @@ int64_t local_max_min(const Problem& prob, std::vector<Vec3>& pts, const Untangl
   };
   // While v moves, only 5 of a hex's 9 scaled Jacobian terms change: the centre, v's corner
   // and the corners of its 3 edge neighbours. rest[i - first(v)] holds the minimum of the other
-  // 4 for v's hex slot i (a degenerate term is -2, below any value, so for finite points the
-  // minimum keeps it and equals scaled_jacobian exactly).
+  // 4 for v's hex slot i (a degenerate term is -2, below any value, so the minimum keeps it and
+  // equals scaled_jacobian exactly, given 8 distinct points per hex, as reconstruction builds).
   auto rest_terms = [&](int32_t v, std::vector<double>& rest) {
     rest.resize(last(v) - first(v));
     for (int32_t i = first(v); i < last(v); ++i) {
@@ -618,6 +618,7 @@ int64_t local_max_min(const Problem& prob, std::vector<Vec3>& pts, const Untangl
       double q = rest[i - first(v)];
       for (int term : {0, 1 + k, 1 + nb[0], 1 + nb[1], 1 + nb[2]})
         q = std::min(q, scaled_jacobian_term(c, term));
+      if (q == std::numeric_limits<double>::infinity()) q = kDegenerateScaledJacobian;  // all NaN
       m = std::min(m, q);
       sum += q;
     }

@@ -454,9 +454,12 @@ TEST_F(Cli, ThreadCountDoesNotChangeTheOutput) {
   EXPECT_EQ(qa.exit_code, 0) << qa.err;
   EXPECT_EQ(qb.exit_code, 0) << qb.err;
   EXPECT_EQ(slurp(path("qa.json")), slurp(path("qb.json")));
-  Outcome bad = run({"mesh", in, "-o", path("d.vtk"), "--threads", "-1"});
-  EXPECT_EQ(bad.exit_code, 1) << bad.err;
-  EXPECT_FALSE(fs::exists(path("d.vtk")));
+  for (const char* n : {"-1", "1025"}) {
+    Outcome bad = run({"mesh", in, "-o", path("d.vtk"), "--threads", n});
+    EXPECT_EQ(bad.exit_code, 1) << n << bad.err;
+    EXPECT_TRUE(contains(bad.err, "--threads")) << n << bad.err;
+    EXPECT_FALSE(fs::exists(path("d.vtk")));
+  }
 }
 
 TEST_F(Cli, FailedMeshLeavesNoFileBehind) {

@@ -186,12 +186,26 @@ TEST(ScaledJacobian, NonFiniteCornerGivesNoValueBelowVerdictsStart) {
 TEST(ScaledJacobian, TermsAreTheNineJacobiansAndTheirMinimumIsTheValue) {
   // scaled_jacobian_term(c, 0) is the centre, (c, 1 + k) corner k; the local sweeps rely on the
   // minimum of the nine terms being bit for bit scaled_jacobian.
-  std::mt19937 rng(11);
-  std::uniform_real_distribution<double> jitter(-0.45, 0.45);
+  std::mt19937_64 rng(11);
+  auto jitter = [&] { return 0.45 * uniform(rng); };
   int inverted = 0;
   for (int trial = 0; trial < 200; ++trial) {
     Corners c = unit_cube();
-    for (Vec3& p : c) p += Vec3(jitter(rng), jitter(rng), jitter(rng));
+    for (Vec3& p : c) p += Vec3(jitter(), jitter(), jitter());
+    // Moving point k changes only the centre, corner k and the corners of k's 3 frame
+    // neighbours; the sweeps cache the other 4 corners' terms while a point moves.
+    for (int k = 0; k < 8; ++k) {
+      Corners moved = c;
+      moved[k] += Vec3(jitter(), jitter(), jitter());
+      const auto& nb = kHexCornerFrames[k];
+      for (int corner = 0; corner < 8; ++corner) {
+        const bool uses_k = corner == k || corner == nb[0] || corner == nb[1] || corner == nb[2];
+        if (uses_k)
+          EXPECT_NE(scaled_jacobian_term(moved, 1 + corner), scaled_jacobian_term(c, 1 + corner));
+        else
+          EXPECT_EQ(scaled_jacobian_term(moved, 1 + corner), scaled_jacobian_term(c, 1 + corner));
+      }
+    }
     const auto corners = corner_values(c);
     EXPECT_NEAR(scaled_jacobian_term(c, 0), centre_value(c), 1e-14);
     double lowest = scaled_jacobian_term(c, 0);
