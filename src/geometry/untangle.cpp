@@ -589,40 +589,43 @@ int64_t local_max_min(const Problem& prob, std::vector<Vec3>& pts, const Untangl
     for (int k = 0; k < 8; ++k) c[k] = pts[hexes[h][k]];
     return scaled_jacobian(c);
   };
-  // While v moves, only 5 of a hex's 9 scaled Jacobian terms change: the centre, v's corner
-  // and the corners of its 3 edge neighbours. rest[i - first(v)] holds the minimum of the other
-  // 4 for v's hex slot i (a degenerate term is -2, below any value, so the minimum keeps it and
-  // equals scaled_jacobian exactly, given 8 distinct points per hex, as reconstruction builds).
-  auto rest_terms = [&](int32_t v, std::vector<double>& rest) {
-    rest.resize(last(v) - first(v));
+  // While v moves, only v's point of each of its hexes changes, and only 5 of a hex's 9 scaled
+  // Jacobian terms: the centre, v's corner k and the corners of k's 3 edge neighbours. A search
+  // keeps, per hex of v, the hex's points (c[k] is v's, updated per trial) and the minimum of the
+  // other 4 terms (a degenerate term is -2, below any value, so the minimum keeps it and equals
+  // scaled_jacobian exactly, given 8 distinct points per hex, as reconstruction builds).
+  struct HexOfVertex {
+    std::array<Vec3, 8> c;
+    int k;
+    double rest;
+  };
+  auto hexes_of = [&](int32_t v, std::vector<HexOfVertex>& out) {
+    out.resize(last(v) - first(v));
     for (int32_t i = first(v); i < last(v); ++i) {
-      const int k = prob.inc_slot[i] % 8;
-      const auto& nb = kHexCornerFrames[k];
-      std::array<Vec3, 8> c;
-      for (int j = 0; j < 8; ++j) c[j] = pts[hexes[prob.inc_slot[i] / 8][j]];
-      double m = std::numeric_limits<double>::infinity();
+      HexOfVertex& h = out[i - first(v)];
+      h.k = prob.inc_slot[i] % 8;
+      for (int j = 0; j < 8; ++j) h.c[j] = pts[hexes[prob.inc_slot[i] / 8][j]];
+      const auto& nb = kHexCornerFrames[h.k];
+      h.rest = std::numeric_limits<double>::infinity();
       for (int corner = 0; corner < 8; ++corner)
-        if (corner != k && corner != nb[0] && corner != nb[1] && corner != nb[2])
-          m = std::min(m, scaled_jacobian_term(c, 1 + corner));
-      rest[i - first(v)] = m;
+        if (corner != h.k && corner != nb[0] && corner != nb[1] && corner != nb[2])
+          h.rest = std::min(h.rest, scaled_jacobian_term(h.c, 1 + corner));
     }
   };
-  // (min, mean) of the scaled Jacobians of v's hexes, given rest_terms(v)
-  auto vertex_quality = [&](int32_t v, const std::vector<double>& rest) {
+  // (min, mean) of the scaled Jacobians of v's hexes with v at p
+  auto vertex_quality = [&](const Vec3& p, std::vector<HexOfVertex>& hs) {
     double m = std::numeric_limits<double>::infinity(), sum = 0.0;
-    for (int32_t i = first(v); i < last(v); ++i) {
-      const int k = prob.inc_slot[i] % 8;
-      const auto& nb = kHexCornerFrames[k];
-      std::array<Vec3, 8> c;
-      for (int j = 0; j < 8; ++j) c[j] = pts[hexes[prob.inc_slot[i] / 8][j]];
-      double q = rest[i - first(v)];
-      for (int term : {0, 1 + k, 1 + nb[0], 1 + nb[1], 1 + nb[2]})
-        q = std::min(q, scaled_jacobian_term(c, term));
+    for (HexOfVertex& h : hs) {
+      h.c[h.k] = p;
+      const auto& nb = kHexCornerFrames[h.k];
+      double q = h.rest;
+      for (int term : {0, 1 + h.k, 1 + nb[0], 1 + nb[1], 1 + nb[2]})
+        q = std::min(q, scaled_jacobian_term(h.c, term));
       if (q == std::numeric_limits<double>::infinity()) q = kDegenerateScaledJacobian;  // all NaN
       m = std::min(m, q);
       sum += q;
     }
-    return std::pair<double, double>{m, sum / std::max<int32_t>(1, last(v) - first(v))};
+    return std::pair<double, double>{m, sum / std::max<size_t>(1, hs.size())};
   };
   // A step must not lower the minimum and must raise minimum + w * mean: w = local_mean_weight
   // for the worst hexes' vertices; the other vertices' steps are for the mean alone (kMeanOnly:
@@ -648,9 +651,9 @@ int64_t local_max_min(const Problem& prob, std::vector<Vec3>& pts, const Untangl
       for (int32_t u : hexes[prob.inc_slot[i] / 8])
         if (u != v) len += (pts[u] - pts[v]).norm(), ++count;
     const double l = count > 0 ? len / count : 0.0;
-    std::vector<double> rest;
-    rest_terms(v, rest);
-    std::pair<double, double> cur = vertex_quality(v, rest);
+    std::vector<HexOfVertex> hs;
+    hexes_of(v, hs);
+    std::pair<double, double> cur = vertex_quality(pts[v], hs);
     int32_t moved = 0;
     double step = 0.1 * l;
     for (int it = 0; it < 200 && step > stop * l; ++it) {
@@ -658,12 +661,11 @@ int64_t local_max_min(const Problem& prob, std::vector<Vec3>& pts, const Untangl
       int best = -1;
       std::pair<double, double> best_q = cur;
       for (int d = 0; d < 14; ++d) {
-        pts[v] = old + step * dirs[d];
-        const std::pair<double, double> q = vertex_quality(v, rest);
+        const std::pair<double, double> q = vertex_quality(old + step * dirs[d], hs);
         if (q.first >= cur.first && score(q, w) > score(best_q, w)) best_q = q, best = d;
       }
-      pts[v] = best >= 0 ? Vec3(old + step * dirs[best]) : old;
       if (best >= 0) {
+        pts[v] = old + step * dirs[best];
         cur = best_q;
         ++moved;
       } else {
