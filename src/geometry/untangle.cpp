@@ -263,22 +263,46 @@ void build_problem(Problem& prob, const std::vector<Hex>& hexes, const std::vect
   prob.finish_setup();
 }
 
-/// Runs L-BFGS on `kernel` from x; x ends at the lowest finite energy seen. Returns iterations.
+/// When an L-BFGS run stops, besides its gradient test and iteration cap.
+enum class StopRule : uint8_t {
+  gradient,  ///< the gradient test and the iteration cap only
+  /// also once E fell by less than `delta` times |E| over the last inner_past iterations
+  delta,
+  /// the gradient test while some term is <= 0; from the first point where every term is
+  /// positive (min_corner_value() > 0), a fresh run with the delta test
+  delta_once_positive,
+};
+
+/// Runs L-BFGS on `kernel` from x; x ends at the lowest finite energy seen (with
+/// delta_once_positive, the lowest seen after the switch). `delta` <= 0 turns both delta rules
+/// into `gradient`. Returns the iterations of the runs that ended normally (a run cut short by
+/// a line search failure or by the switch counts 0; its evaluations are counted).
 template <typename Kernel>
 int minimize(Problem& prob, const Kernel& kernel, Eigen::VectorXd& x, const UntangleParams& p,
-             int max_iterations) {
+             int max_iterations, StopRule rule = StopRule::gradient, double delta = 0.0) {
   if (x.size() == 0) return 0;
+  if (!(delta > 0.0)) rule = StopRule::gradient;
   LBFGSpp::LBFGSParam<double> lp;
   lp.m = p.lbfgs_memory;
   lp.epsilon = 1e-10;
   lp.epsilon_rel = p.inner_gtol;
   lp.max_iterations = max_iterations;
   lp.max_linesearch = 40;
+  if (rule == StopRule::delta) {
+    lp.past = p.inner_past;
+    lp.delta = delta;
+  }
+  struct Positive {};  // thrown by the first evaluation that finds every term positive
   LBFGSpp::LBFGSSolver<double> solver(lp);
   double best = std::numeric_limits<double>::infinity();
   Eigen::VectorXd best_x = x;
+  const int evaluations_before = prob.evaluations;
   auto fun = [&](const Eigen::VectorXd& y, Eigen::VectorXd& g) {
     const double f = prob.evaluate(y, g, kernel);
+    if (rule == StopRule::delta_once_positive && std::isfinite(f) && prob.min_corner_value() > 0.0) {
+      best_x = y;  // a line search trial may lie above the best energy seen: it is taken anyway
+      throw Positive{};
+    }
     if (std::isfinite(f) && f < best) {
       best = f;
       best_x = y;
@@ -289,6 +313,10 @@ int minimize(Problem& prob, const Kernel& kernel, Eigen::VectorXd& x, const Unta
   double fx = 0.0;
   try {
     iters = solver.minimize(fun, x, fx);
+  } catch (const Positive&) {
+    x = best_x;
+    const int left = max_iterations - (prob.evaluations - evaluations_before);
+    return left > 0 ? minimize(prob, kernel, x, p, left, StopRule::delta, delta) : 0;
   } catch (const std::exception&) {
     // Line search failures near the optimum or at the barrier: keep the best point seen (the
     // iterations of an interrupted run are not known; evaluations are counted instead).
@@ -546,11 +574,13 @@ namespace {
 
 /// Minimizes `kernel` over the free points of `prob` that `sub_fixed` leaves free, the others
 /// pinned where x has them (prob.pos must hold x: evaluate() last called at x), at most
-/// `iterations` L-BFGS iterations, and writes the result back into x. `sub` is reused storage.
+/// `iterations` L-BFGS iterations (and the delta test with `delta`, see StopRule), and writes
+/// the result back into x. `sub` is reused storage.
 /// Returns the number of points the region freed; adds the work to `st`.
 int32_t minimize_region(Problem& prob, Problem& sub, const std::vector<uint8_t>& sub_fixed,
                         const QualityKernel& kernel, Eigen::VectorXd& x,
-                        const UntangleParams& params, int iterations, UntanglePhaseStats& st) {
+                        const UntangleParams& params, int iterations, double delta,
+                        UntanglePhaseStats& st) {
   sub.base = prob.pos;
   build_problem(sub, prob.hexes, sub_fixed, params.collinear_tol, nullptr, nullptr);
   const int32_t ns = static_cast<int32_t>(sub.free_point.size());
@@ -558,7 +588,7 @@ int32_t minimize_region(Problem& prob, Problem& sub, const std::vector<uint8_t>&
   for (int32_t u = 0; u < ns; ++u) xs.segment<3>(3 * u) = sub.base[sub.free_point[u]];
   const int ev_sub = sub.evaluations;
   const int64_t cev_sub = sub.corner_evaluations;
-  st.iterations += minimize(sub, kernel, xs, params, iterations);
+  st.iterations += minimize(sub, kernel, xs, params, iterations, StopRule::delta, delta);
   st.evaluations += sub.evaluations - ev_sub;
   st.corner_evaluations += sub.corner_evaluations - cev_sub;
   for (int32_t u = 0; u < ns; ++u)
@@ -825,7 +855,12 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
         res.stats.untangle.factorizations += nr.factorizations;
         res.stats.untangle.solve_time_s += nr.solve_time_s;
       } else {
-        res.stats.untangle.iterations += minimize(prob, k, x, params, params.max_inner);
+        // When phase 2 follows, the round that untangles relaxes only until E flattens.
+        const bool relax_briefly = params.optimize && !params.relax_after_untangle;
+        res.stats.untangle.iterations +=
+            minimize(prob, k, x, params, params.max_inner,
+                     relax_briefly ? StopRule::delta_once_positive : StopRule::gradient,
+                     params.inner_delta);
       }
       const double e = prob.evaluate(x, g, k);
       detmin = prob.min_corner_value();
@@ -915,9 +950,10 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
         std::vector<uint8_t> sub_fixed(prob.base.size(), 1);
         for (int32_t v : prob.free_point) sub_fixed[v] = in_region[v] ? 0 : 1;
         minimize_region(prob, sub, sub_fixed, k, x, params, params.max_quality_inner,
-                        res.stats.optimize);
+                        params.restart_delta, res.stats.optimize);
       } else {
-        res.stats.optimize.iterations += minimize(prob, k, x, params, params.max_quality_inner);
+        res.stats.optimize.iterations += minimize(prob, k, x, params, params.max_quality_inner,
+                                                  StopRule::delta, params.restart_delta);
       }
       prob.evaluate(x, g, k);
       const double s = prob.min_corner_value();
@@ -947,7 +983,8 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
       km.mean_beta = params.mean_beta;
       km.mean_weight = params.mean_weight;
       const int32_t ns = minimize_region(prob, sub, sub_fixed, km, x, params,
-                                         params.max_mean_inner, res.stats.optimize);
+                                         params.max_mean_inner, params.inner_delta,
+                                         res.stats.optimize);
       prob.evaluate(x, g, k);
       res.stats.mean_polish_kept = ns > 0 && prob.min_corner_value() >= s_now;
       if (!res.stats.mean_polish_kept) {

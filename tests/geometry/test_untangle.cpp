@@ -262,6 +262,34 @@ TEST(GeometryUntangle, PhaseOneStopsOnceUntangled) {
 }
 
 // Phase 2 focused on the worst corners: evaluates fewer corner terms than the whole-mesh
+
+// The delta test (inner_delta): phase 1 relaxes only until E flattens once every term is
+// positive, and phase 2's runs stop the same way: fewer evaluations in both phases, still
+// untangled, the minimum and mean within a small margin of the runs without it. With
+// relax_after_untangle, phase 1 does not use it (the same evaluations either way).
+TEST(GeometryUntangle, DeltaTestStopsRelaxationEarlier) {
+  Generated g = testing::jittered(testing::cubed_sphere_equiangular(6), 5, 0.3);
+  ASSERT_GT(run_quality(g.known_mesh).sj_count_nonpositive, 0);
+  UntangleParams with, without;
+  without.inner_delta = 0.0;
+  UntangleResult a = run_untangle(g.known_mesh, surface_fixed(g), with);
+  UntangleResult b = run_untangle(g.known_mesh, surface_fixed(g), without);
+  EXPECT_EQ(a.stats.untangle.nonpositive_after, 0);
+  EXPECT_EQ(b.stats.untangle.nonpositive_after, 0);
+  EXPECT_LT(a.stats.untangle.evaluations, b.stats.untangle.evaluations);
+  EXPECT_LT(a.stats.optimize.evaluations, b.stats.optimize.evaluations);
+  const QualityReport qa = run_quality(a.mesh), qb = run_quality(b.mesh);
+  EXPECT_EQ(qa.sj_count_nonpositive, 0);
+  EXPECT_GE(qa.sj_min, qb.sj_min - 0.02) << qa.sj_min << " vs " << qb.sj_min;
+  EXPECT_GE(qa.sj_mean, qb.sj_mean - 0.01) << qa.sj_mean << " vs " << qb.sj_mean;
+
+  with.relax_after_untangle = without.relax_after_untangle = true;
+  with.optimize = without.optimize = false;
+  a = run_untangle(g.known_mesh, surface_fixed(g), with);
+  b = run_untangle(g.known_mesh, surface_fixed(g), without);
+  EXPECT_EQ(a.stats.untangle.evaluations, b.stats.untangle.evaluations);
+  EXPECT_EQ(a.mesh.points, b.mesh.points);
+}
 // optimization, keeps every hex positive and does not lower the minimum reached by phase 1.
 TEST(GeometryUntangle, FocusedOptimizeEvaluatesLessAndKeepsQuality) {
   // A unit-cell grid whose boundary is dented at one vertex (the centre of the bottom face): the
