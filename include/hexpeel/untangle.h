@@ -110,8 +110,14 @@ struct UntangleParams {
   /// (8 corners and the centre): larger beta focuses harder on the worst ones (dimensionless, 1..200).
   double beta = 30.0;
   /// Phase 2 adds this times the phase 1 energy (eps ~ 0), which keeps edges from collapsing
-  /// (the scaled Jacobian alone does not see size). Dimensionless, >= 0.
-  double regularization = 0.1;
+  /// (the scaled Jacobian alone does not see size). Dimensionless, >= 0. 0.01 (was 0.1): the
+  /// Winslow term pulled against the smoothed minimum; on 79 surfaces (issue 6) 0.01 raised the
+  /// min SJ on 29 (pierrot 0.127 -> 0.306, plus_large 0.360 -> 0.479) and the mean on 32
+  /// (screw2 0.518 -> 0.547); the min fell on one (by 0.001), the mean on one (rvox_s7, by 0.03,
+  /// whose min rose 0.31 -> 0.47); the untangling stage took about 3x as long. 0.003 raised the
+  /// min a little more but lowered the mean on 6 (star5 by 0.03); 0.1 kept for the mean polish
+  /// alone lowered the mean on 32.
+  double regularization = 0.01;
   /// Phase 2 then runs local max-min sweeps: the free vertices of the local_hexes worst hexes,
   /// worst first, each moved by a pattern search whose steps never lower the minimum of its hexes
   /// (sequential, deterministic; the global minimum never drops). With local_all, every other

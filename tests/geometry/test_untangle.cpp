@@ -424,7 +424,8 @@ TEST(GeometryUntangle, OptimizeNeverLowersTheMinimum) {
 // The mean polish raises the mean scaled Jacobian and leaves the minimum where the restarts put
 // it (the hexes near it are pinned, no other corner may drop below it).
 TEST(GeometryUntangle, MeanPolishRaisesTheMeanAndKeepsTheMinimum) {
-  Generated g = testing::jittered(testing::cubed_sphere_equiangular(4), 5, 0.2);
+  // n = 6: on n = 4 the restarts alone (regularization 0.01) leave the polish only +0.002.
+  Generated g = testing::jittered(testing::cubed_sphere_equiangular(6), 5, 0.2);
   UntangleParams p;
   p.local_sweeps = 0;  // the polish alone
   p.max_mean_inner = 0;
