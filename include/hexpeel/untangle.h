@@ -78,19 +78,22 @@ struct UntangleParams {
   /// continuation cannot help either (screw2 --method original: 190 -> 172 inverted, 754 s with
   /// 100 rounds a step while CI ran alongside).
   int morph_step_rounds = 40;
-  int max_inner = 200;            ///< L-BFGS iterations per round, both phases (1..100000)
+  /// At most this many L-BFGS iterations per phase 1 round (fewer when the delta test below stops
+  /// the run), 1..100000.
+  int max_inner = 200;
   double inner_gtol = 1e-5;       ///< L-BFGS gradient tolerance, relative to |x| (> 0)
   /// The delta test: an L-BFGS run also stops once its energy fell by less than delta times |E|
   /// over the last inner_past iterations (LBFGSpp's test; delta 0 turns it off). inner_delta
-  /// applies to phase 1 (when phase 2 follows) from the first point with every term positive,
+  /// applies to phase 1's L-BFGS runs when phase 1 stops at the first untangled round (optimize
+  /// and not relax_after_untangle), from the first point with every term positive,
   /// and to phase 2's mean polish; restart_delta to phase 2's restarts, which lift the worst
   /// corners and gain little per step. A tangled phase 1 run keeps all max_inner iterations
-  /// (shorter rounds left screw2 inverted). Measured (issue 6): 10k-hex jittered sphere 3.1 s ->
+  /// (shorter rounds left screw2 inverted). Measured (issue 6, regularization 0.1): 10k-hex sphere 3.1 s ->
   /// 1.8 s, pierrot's untangling 36 s -> 22 s; on 79 surfaces the min SJ rose on 16 and fell on
   /// 11 (by at most 0.011); the mean rose by up to 0.005 and fell by at most 0.002.
   double inner_delta = 1e-4;
   double restart_delta = 1e-6;
-  int inner_past = 10;            ///< (1..1000)
+  int inner_past = 10;            ///< iterations the delta test looks back (1..1000)
   double energy_rtol = 1e-5;      ///< phase 1 stops once all terms are positive and E changes by less
   /// Phase 1 stopping rule. false (default): when phase 2 runs, stop after the first round that
   /// leaves every term (corner, centre) positive; phase 2, whose objective includes the Winslow energy at
@@ -149,7 +152,9 @@ struct UntangleParams {
   /// raises the minimum corner s by less than 1e-3. 6 (was 4): with focus_width the restarts are
   /// cheap, and csphere_n12 still gained 0.005 in its 4th.
   int max_quality_rounds = 6;
-  int max_quality_inner = 150;    ///< L-BFGS iterations per phase 2 restart (1..100000)
+  /// At most this many L-BFGS iterations per phase 2 restart (fewer when restart_delta stops the
+  /// run), 1..100000.
+  int max_quality_inner = 150;
   /// Phase 2 moves only the vertices near the worst corners: each restart frees the vertices of
   /// the hexes with a corner s < s_min + focus_width plus focus_rings rings of hexes around them
   /// and pins the rest. Corners above that weigh less than exp(-beta focus_width) in the smoothed
@@ -162,7 +167,9 @@ struct UntangleParams {
 
 struct UntanglePhaseStats {
   int32_t rounds = 0;        ///< outer rounds (epsilon updates / phase 2 restarts)
-  int32_t iterations = 0;    ///< L-BFGS iterations, summed over rounds
+  /// L-BFGS iterations, summed over rounds; a run cut short (a line search failure, or phase 1
+  /// switching to the delta test at its first untangled point) adds only its evaluations.
+  int32_t iterations = 0;
   int32_t evaluations = 0;   ///< energy + gradient evaluations (of the whole mesh or a region)
   int64_t corner_evaluations = 0;  ///< corner and centre terms evaluated, summed over evaluations
   int32_t factorizations = 0;  ///< Newton: numeric Cholesky factorizations (0 for L-BFGS)

@@ -12,7 +12,9 @@
 // with an epsilon update after each inner minimization (UntangleParams::eps_rule: by default eps
 // tracks a fifth of the worst det, the rule of the authors' code; the paper's provable rule is
 // the alternative) and a stall test (UntangleParams::stall_rounds); by default phase 1 ends at the first round that leaves every corner positive
-// (UntangleParams::relax_after_untangle) and phase 2 does the remaining relaxation. The inner
+// (UntangleParams::relax_after_untangle), its L-BFGS run relaxing from the first untangled
+// point only until the energy flattens (the delta test, UntangleParams::inner_delta; phase 2's
+// runs stop the same way), and phase 2 does the remaining relaxation. The inner
 // minimizer is L-BFGS or projected Newton (UntangleParams::solver): the
 // corner Hessians in closed form with negative eigenvalues clamped (untangle_kernels.h),
 // assembled into a sparse matrix over the free vertices (corner terms only: the centre terms
@@ -289,7 +291,7 @@ int minimize(Problem& prob, const Kernel& kernel, Eigen::VectorXd& x, const Unta
   lp.max_iterations = max_iterations;
   lp.max_linesearch = 40;
   if (rule == StopRule::delta) {
-    lp.past = p.inner_past;
+    lp.past = std::clamp(p.inner_past, 1, 1000);
     lp.delta = delta;
   }
   struct Positive {};  // thrown by the first evaluation that finds every term positive

@@ -381,8 +381,8 @@ TEST_F(Cli, MeshWritesMeshAndReport) {
   EXPECT_EQ(j.at("orders_tried")[0].at("side_rule"), j.at("method").at("side_rule"));
 }
 
-// --no-mean-sweep: the sweep over every interior vertex is skipped (fewer local moves, a lower
-// mean); --alternatives is range-checked.
+// --no-mean-sweep: the sweep over every interior vertex is skipped (other bytes, a lower mean);
+// --alternatives is range-checked.
 TEST_F(Cli, MeanSweepCanBeSkipped) {
   const std::string in =
       write("rvox.obj", gen::pillowed(gen::random_voxel_solid(3, 4, 12, 2), 3, 0.3).surface);

@@ -261,12 +261,11 @@ TEST(GeometryUntangle, PhaseOneStopsOnceUntangled) {
   EXPECT_EQ(run_quality(a.mesh).sj_count_nonpositive, 0);
 }
 
-// Phase 2 focused on the worst corners: evaluates fewer corner terms than the whole-mesh
-
 // The delta test (inner_delta): phase 1 relaxes only until E flattens once every term is
 // positive, and phase 2's runs stop the same way: fewer evaluations in both phases, still
-// untangled, the minimum and mean within a small margin of the runs without it. With
-// relax_after_untangle, phase 1 does not use it (the same evaluations either way).
+// untangled, the minimum and mean within a small margin of the runs without it. Phase 1 does not
+// use it with relax_after_untangle, nor in rounds that stay tangled (a forced inversion keeps
+// every round tangled: the same phase 1 either way).
 TEST(GeometryUntangle, DeltaTestStopsRelaxationEarlier) {
   Generated g = testing::jittered(testing::cubed_sphere_equiangular(6), 5, 0.3);
   ASSERT_GT(run_quality(g.known_mesh).sj_count_nonpositive, 0);
@@ -284,12 +283,30 @@ TEST(GeometryUntangle, DeltaTestStopsRelaxationEarlier) {
   EXPECT_GE(qa.sj_mean, qb.sj_mean - 0.01) << qa.sj_mean << " vs " << qb.sj_mean;
 
   with.relax_after_untangle = without.relax_after_untangle = true;
-  with.optimize = without.optimize = false;
   a = run_untangle(g.known_mesh, surface_fixed(g), with);
   b = run_untangle(g.known_mesh, surface_fixed(g), without);
+  EXPECT_EQ(a.stats.untangle.rounds, b.stats.untangle.rounds);
   EXPECT_EQ(a.stats.untangle.evaluations, b.stats.untangle.evaluations);
-  EXPECT_EQ(a.mesh.points, b.mesh.points);
+
+  Generated f = testing::cube(3, 3, 3, 1.0);  // a boundary corner pushed deep inside
+  int32_t corner = 0;
+  for (int32_t v = 0; v < f.surface.num_points(); ++v)
+    if (f.known_mesh.points[v].sum() < f.known_mesh.points[corner].sum()) corner = v;
+  f.known_mesh.points[corner] = Vec3(2.6, 2.6, 2.6);
+  with.relax_after_untangle = without.relax_after_untangle = false;
+  with.morph_stages = without.morph_stages = 0;
+  with.stall_rounds = without.stall_rounds = 5;
+  a = run_untangle(f.known_mesh, surface_fixed(f), with);
+  b = run_untangle(f.known_mesh, surface_fixed(f), without);
+  ASSERT_GT(b.stats.untangle.rounds, 1);
+  ASSERT_GT(b.stats.untangle.nonpositive_after, 0);
+  EXPECT_EQ(a.stats.untangle.rounds, b.stats.untangle.rounds);
+  EXPECT_EQ(a.stats.untangle.evaluations, b.stats.untangle.evaluations);
+  EXPECT_EQ(a.stats.untangle.nonpositive_after, b.stats.untangle.nonpositive_after);
 }
+
+// Phase 2 focused on the worst corners: evaluates fewer corner terms than the whole-mesh
+
 // optimization, keeps every hex positive and does not lower the minimum reached by phase 1.
 TEST(GeometryUntangle, FocusedOptimizeEvaluatesLessAndKeepsQuality) {
   // A unit-cell grid whose boundary is dented at one vertex (the centre of the bottom face): the
