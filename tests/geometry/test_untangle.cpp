@@ -27,6 +27,17 @@ std::vector<uint8_t> surface_fixed(const Generated& g) {
   return fixed;
 }
 
+/// A 3x3x3 grid whose lowest boundary corner is pushed deep inside (to 2.6, 2.6, 2.6): a forced
+/// inversion no placement of the free vertices fixes.
+Generated cube_with_corner_pushed_inside() {
+  Generated g = testing::cube(3, 3, 3, 1.0);
+  int32_t corner = 0;
+  for (int32_t v = 0; v < g.surface.num_points(); ++v)
+    if (g.known_mesh.points[v].sum() < g.known_mesh.points[corner].sum()) corner = v;
+  g.known_mesh.points[corner] = Vec3(2.6, 2.6, 2.6);
+  return g;
+}
+
 HexComplex complex_of(const Generated& g) {
   HexComplex c;
   c.num_vertices = g.known_mesh.num_points();
@@ -288,11 +299,7 @@ TEST(GeometryUntangle, DeltaTestStopsRelaxationEarlier) {
   EXPECT_EQ(a.stats.untangle.rounds, b.stats.untangle.rounds);
   EXPECT_EQ(a.stats.untangle.evaluations, b.stats.untangle.evaluations);
 
-  Generated f = testing::cube(3, 3, 3, 1.0);  // a boundary corner pushed deep inside
-  int32_t corner = 0;
-  for (int32_t v = 0; v < f.surface.num_points(); ++v)
-    if (f.known_mesh.points[v].sum() < f.known_mesh.points[corner].sum()) corner = v;
-  f.known_mesh.points[corner] = Vec3(2.6, 2.6, 2.6);
+  const Generated f = cube_with_corner_pushed_inside();
   with.relax_after_untangle = without.relax_after_untangle = false;
   with.morph_stages = without.morph_stages = 0;
   with.stall_rounds = without.stall_rounds = 5;
@@ -345,11 +352,7 @@ TEST(GeometryUntangle, FocusedOptimizeEvaluatesLessAndKeepsQuality) {
 // the boundary continuation runs (and keeps the better result), and the bytes do not depend on
 // the thread count.
 TEST(GeometryUntangle, ForcedInversionStallsAndStaysDeterministic) {
-  Generated g = testing::cube(3, 3, 3, 1.0);
-  int32_t corner = 0;
-  for (int32_t v = 0; v < g.surface.num_points(); ++v)
-    if (g.known_mesh.points[v].sum() < g.known_mesh.points[corner].sum()) corner = v;
-  g.known_mesh.points[corner] = Vec3(2.6, 2.6, 2.6);
+  const Generated g = cube_with_corner_pushed_inside();
   const int32_t before = run_quality(g.known_mesh).sj_count_nonpositive;
   ASSERT_GT(before, 0);
   UntangleParams p;
