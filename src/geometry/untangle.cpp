@@ -53,6 +53,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
 #include <numeric>
 #include <chrono>
 #include <cmath>
@@ -109,6 +110,10 @@ struct Problem {
   std::vector<Vec3> hex_g;                       ///< gradient per hex and local point (8 slots)
   std::vector<double> block_sum;                 ///< per-block energy sums
   std::vector<double> block_min;                 ///< per-block min of det (phase 1) or s (phase 2)
+  /// While set (by minimize), an evaluation whose energy is +inf (a trial point the line search
+  /// will reject) stops early: blocks not yet started are skipped and the gradient is not
+  /// gathered, so block_min and the gradient are then incomplete (only +inf is returned).
+  bool abandon_infinite = false;
   int evaluations = 0;                           ///< energy + gradient evaluations so far
   int64_t corner_evaluations = 0;                ///< active corners times evaluations so far
 
@@ -149,8 +154,13 @@ struct Problem {
     corner_evaluations += num_corners() + num_centres;
     set_positions(x);
     const int32_t nb = num_blocks(), nh = num_hexes();
+    std::atomic<bool> infinite{false};
     tbb::parallel_for(tbb::blocked_range<int32_t>(0, nb), [&](const tbb::blocked_range<int32_t>& r) {
       for (int32_t b = r.begin(); b != r.end(); ++b) {
+        if (abandon_infinite && infinite.load(std::memory_order_relaxed)) {
+          block_sum[b] = std::numeric_limits<double>::infinity();
+          continue;
+        }
         double s = 0.0, m = std::numeric_limits<double>::infinity();
         const int32_t end = std::min(nh, (b + 1) * kBlock);
         for (int32_t h = b * kBlock; h < end; ++h) {
@@ -161,10 +171,13 @@ struct Problem {
         }
         block_sum[b] = s;
         block_min[b] = m;
+        if (s == std::numeric_limits<double>::infinity()) infinite.store(true, std::memory_order_relaxed);
       }
     });
     double total = 0.0;
     for (int32_t b = 0; b < nb; ++b) total += block_sum[b];
+    if (abandon_infinite && infinite.load(std::memory_order_relaxed))
+      return std::numeric_limits<double>::infinity();
     const int32_t nu = static_cast<int32_t>(free_point.size());
     tbb::parallel_for(tbb::blocked_range<int32_t>(0, nu, 1024), [&](const tbb::blocked_range<int32_t>& r) {
       for (int32_t u = r.begin(); u != r.end(); ++u) {
@@ -295,6 +308,13 @@ int minimize(Problem& prob, const Kernel& kernel, Eigen::VectorXd& x, const Unta
     lp.delta = delta;
   }
   struct Positive {};  // thrown by the first evaluation that finds every term positive
+  // A trial point with energy +inf is only rejected by the line search: its evaluation may stop
+  // at the first infinite block (the callers re-evaluate at the returned x).
+  struct Abandon {
+    Problem& p;
+    explicit Abandon(Problem& q) : p(q) { p.abandon_infinite = true; }
+    ~Abandon() { p.abandon_infinite = false; }
+  } abandon(prob);
   LBFGSpp::LBFGSSolver<double> solver(lp);
   double best = std::numeric_limits<double>::infinity();
   Eigen::VectorXd best_x = x;
