@@ -110,10 +110,6 @@ struct Problem {
   std::vector<Vec3> hex_g;                       ///< gradient per hex and local point (8 slots)
   std::vector<double> block_sum;                 ///< per-block energy sums
   std::vector<double> block_min;                 ///< per-block min of det (phase 1) or s (phase 2)
-  /// While set (by minimize), an evaluation whose energy is +inf (a trial point the line search
-  /// will reject) stops early: blocks not yet started are skipped and the gradient is not
-  /// gathered, so block_min and the gradient are then incomplete (only +inf is returned).
-  bool abandon_infinite = false;
   int evaluations = 0;                           ///< energy + gradient evaluations so far
   int64_t corner_evaluations = 0;                ///< active corners times evaluations so far
 
@@ -147,9 +143,13 @@ struct Problem {
   }
 
   /// Evaluates the sum of kernel.hex over the hexes (energy, per-hex gradients, block minima)
-  /// and gathers the gradient per unknown.
+  /// and gathers the gradient per unknown. With `abandon_infinite` (a line search's trial point,
+  /// which +inf only rejects), an evaluation whose energy is +inf stops early: blocks not yet
+  /// started are skipped and the gradient is not gathered, so block_min and the gradient are
+  /// then incomplete (only +inf is returned).
   template <typename Kernel>
-  double evaluate(const Eigen::VectorXd& x, Eigen::VectorXd& grad, const Kernel& kernel) {
+  double evaluate(const Eigen::VectorXd& x, Eigen::VectorXd& grad, const Kernel& kernel,
+                  bool abandon_infinite = false) {
     ++evaluations;
     corner_evaluations += num_corners() + num_centres;
     set_positions(x);
@@ -308,19 +308,14 @@ int minimize(Problem& prob, const Kernel& kernel, Eigen::VectorXd& x, const Unta
     lp.delta = delta;
   }
   struct Positive {};  // thrown by the first evaluation that finds every term positive
-  // A trial point with energy +inf is only rejected by the line search: its evaluation may stop
-  // at the first infinite block (the callers re-evaluate at the returned x).
-  struct Abandon {
-    Problem& p;
-    explicit Abandon(Problem& q) : p(q) { p.abandon_infinite = true; }
-    ~Abandon() { p.abandon_infinite = false; }
-  } abandon(prob);
   LBFGSpp::LBFGSSolver<double> solver(lp);
   double best = std::numeric_limits<double>::infinity();
   Eigen::VectorXd best_x = x;
   const int evaluations_before = prob.evaluations;
   auto fun = [&](const Eigen::VectorXd& y, Eigen::VectorXd& g) {
-    const double f = prob.evaluate(y, g, kernel);
+    // A trial point with energy +inf is only rejected by the line search: its evaluation may
+    // stop at the first infinite block (the callers re-evaluate at the returned x).
+    const double f = prob.evaluate(y, g, kernel, /*abandon_infinite=*/true);
     if (rule == StopRule::delta_once_positive && std::isfinite(f) && prob.min_corner_value() > 0.0) {
       best_x = y;  // a line search trial may lie above the best energy seen: it is taken anyway
       throw Positive{};
