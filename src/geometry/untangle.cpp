@@ -110,6 +110,13 @@ struct Problem {
   std::vector<Vec3> hex_g;                       ///< gradient per hex and local point (8 slots)
   std::vector<double> block_sum;                 ///< per-block energy sums
   std::vector<double> block_min;                 ///< per-block min of det (phase 1) or s (phase 2)
+  std::vector<int32_t> block_infinite;           ///< per block: its first hex of energy +inf, or -1
+  /// Hexes whose energy was +inf at recent rejected trial points (at most kSuspects, the oldest
+  /// replaced first): a trial point checks them before anything else, because the halved steps
+  /// of one line search, and the next search's steps, are usually rejected by the same hexes.
+  std::vector<int32_t> suspects;
+  size_t next_suspect = 0;                       ///< the slot the next suspect replaces
+  static constexpr size_t kSuspects = 32;
   int evaluations = 0;                           ///< energy + gradient evaluations so far
   int64_t corner_evaluations = 0;                ///< active corners times evaluations so far
 
@@ -137,6 +144,9 @@ struct Problem {
     hex_g.resize(8 * static_cast<size_t>(ng));
     block_sum.resize(num_blocks());
     block_min.resize(num_blocks());
+    block_infinite.resize(num_blocks());
+    suspects.clear();
+    next_suspect = 0;
   }
   void set_positions(const Eigen::VectorXd& x) {
     for (size_t i = 0; i < free_point.size(); ++i) pos[free_point[i]] = x.segment<3>(3 * i);
@@ -144,40 +154,66 @@ struct Problem {
 
   /// Evaluates the sum of kernel.hex over the hexes (energy, per-hex gradients, block minima)
   /// and gathers the gradient per unknown. With `abandon_infinite` (a line search's trial point,
-  /// which +inf only rejects), an evaluation whose energy is +inf stops early: blocks not yet
-  /// started are skipped and the gradient is not gathered, so block_min and the gradient are
-  /// then incomplete (only +inf is returned).
+  /// which +inf only rejects), an evaluation whose energy is +inf stops early: it first checks
+  /// the suspects, then skips the blocks not yet started and the rest of the block that found
+  /// it, and does not gather the gradient, so block_min and the gradient are then incomplete
+  /// (only +inf is returned). Whether the energy is +inf does not depend on the suspects or on
+  /// the order the blocks run in, so neither changes a result.
   template <typename Kernel>
   double evaluate(const Eigen::VectorXd& x, Eigen::VectorXd& grad, const Kernel& kernel,
                   bool abandon_infinite = false) {
+    constexpr double kInf = std::numeric_limits<double>::infinity();
     ++evaluations;
     corner_evaluations += num_corners() + num_centres;
     set_positions(x);
+    if (abandon_infinite)
+      for (int32_t h : suspects) {
+        Vec3 p[8], gh[8];
+        for (int k = 0; k < 8; ++k) p[k] = pos[hexes[h][k]], gh[k].setZero();
+        double m = kInf;
+        if (kernel.hex(p, hex_mask[h], gh, m) == kInf) return kInf;
+      }
     const int32_t nb = num_blocks(), nh = num_hexes();
     std::atomic<bool> infinite{false};
     tbb::parallel_for(tbb::blocked_range<int32_t>(0, nb), [&](const tbb::blocked_range<int32_t>& r) {
       for (int32_t b = r.begin(); b != r.end(); ++b) {
+        block_infinite[b] = -1;
         if (abandon_infinite && infinite.load(std::memory_order_relaxed)) {
-          block_sum[b] = std::numeric_limits<double>::infinity();
+          block_sum[b] = kInf;
           continue;
         }
-        double s = 0.0, m = std::numeric_limits<double>::infinity();
+        double s = 0.0, m = kInf;
         const int32_t end = std::min(nh, (b + 1) * kBlock);
         for (int32_t h = b * kBlock; h < end; ++h) {
           Vec3 p[8], gh[8];
           for (int k = 0; k < 8; ++k) p[k] = pos[hexes[h][k]], gh[k].setZero();
-          s += kernel.hex(p, hex_mask[h], gh, m);
+          const double e = kernel.hex(p, hex_mask[h], gh, m);
+          s += e;
           for (int k = 0; k < 8; ++k) hex_g[8 * static_cast<size_t>(h) + k] = gh[k];
+          if (e == kInf && block_infinite[b] < 0) {
+            block_infinite[b] = h;
+            if (abandon_infinite) break;
+          }
         }
         block_sum[b] = s;
         block_min[b] = m;
-        if (s == std::numeric_limits<double>::infinity()) infinite.store(true, std::memory_order_relaxed);
+        if (s == kInf) infinite.store(true, std::memory_order_relaxed);
       }
     });
     double total = 0.0;
     for (int32_t b = 0; b < nb; ++b) total += block_sum[b];
-    if (abandon_infinite && infinite.load(std::memory_order_relaxed))
-      return std::numeric_limits<double>::infinity();
+    if (abandon_infinite && infinite.load(std::memory_order_relaxed)) {
+      for (int32_t b = 0; b < nb; ++b)
+        if (block_infinite[b] >= 0) {
+          if (suspects.size() < kSuspects) {
+            suspects.push_back(block_infinite[b]);
+          } else {
+            suspects[next_suspect] = block_infinite[b];
+            next_suspect = (next_suspect + 1) % kSuspects;
+          }
+        }
+      return kInf;
+    }
     const int32_t nu = static_cast<int32_t>(free_point.size());
     tbb::parallel_for(tbb::blocked_range<int32_t>(0, nu, 1024), [&](const tbb::blocked_range<int32_t>& r) {
       for (int32_t u = r.begin(); u != r.end(); ++u) {
