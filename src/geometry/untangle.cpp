@@ -695,27 +695,44 @@ int64_t local_max_min(const Problem& prob, std::vector<Vec3>& pts, const Untangl
           h.rest = std::min(h.rest, scaled_jacobian_term(h.c, 1 + corner));
     }
   };
-  // (min, mean) of the scaled Jacobians of v's hexes with v at p
-  auto vertex_quality = [&](const Vec3& p, std::vector<HexOfVertex>& hs) {
-    double m = std::numeric_limits<double>::infinity(), sum = 0.0;
-    for (HexOfVertex& h : hs) {
-      h.c[h.k] = p;
-      const auto& nb = kHexCornerFrames[h.k];
-      double q = h.rest;
-      for (int term : {0, 1 + h.k, 1 + nb[0], 1 + nb[1], 1 + nb[2]})
-        q = std::min(q, scaled_jacobian_term(h.c, term));
-      if (q == std::numeric_limits<double>::infinity()) q = kDegenerateScaledJacobian;  // all NaN
-      m = std::min(m, q);
+  // The scaled Jacobian of hex h of v with v at p.
+  auto hex_value = [&](HexOfVertex& h, const Vec3& p) {
+    h.c[h.k] = p;
+    const auto& nb = kHexCornerFrames[h.k];
+    double q = h.rest;
+    for (int term : {0, 1 + h.k, 1 + nb[0], 1 + nb[1], 1 + nb[2]})
+      q = std::min(q, scaled_jacobian_term(h.c, term));
+    return q == std::numeric_limits<double>::infinity() ? kDegenerateScaledJacobian : q;  // all NaN
+  };
+  // (min, mean) of the scaled Jacobians of v's hexes with v at p, and the hex of the minimum. A
+  // trial whose minimum drops below `floor` is rejected whatever its mean, so the evaluation
+  // stops at the first hex below it (then only `min < floor` is meaningful); hex `worst` (the
+  // current minimum's, the likeliest to drop) is tried first. The mean sums in hex order.
+  struct VertexQuality {
+    double min, mean;
+    int worst;
+  };
+  auto vertex_quality = [&](const Vec3& p, std::vector<HexOfVertex>& hs, int worst, double floor) {
+    constexpr double kInf = std::numeric_limits<double>::infinity();
+    const double q_worst = worst >= 0 ? hex_value(hs[worst], p) : kInf;
+    if (q_worst < floor) return VertexQuality{q_worst, 0.0, worst};
+    VertexQuality out{kInf, 0.0, -1};
+    double sum = 0.0;
+    for (int i = 0; i < static_cast<int>(hs.size()); ++i) {
+      const double q = i == worst ? q_worst : hex_value(hs[i], p);
+      if (q < floor) return VertexQuality{q, 0.0, i};
+      if (q < out.min) out.min = q, out.worst = i;
       sum += q;
     }
-    return std::pair<double, double>{m, sum / std::max<size_t>(1, hs.size())};
+    out.mean = sum / std::max<size_t>(1, hs.size());
+    return out;
   };
   // A step must not lower the minimum and must raise minimum + w * mean: w = local_mean_weight
   // for the worst hexes' vertices; the other vertices' steps are for the mean alone (kMeanOnly:
   // scoring their local minimum too lowered the mean).
   constexpr double kMeanOnly = -1.0;
-  auto score = [&](const std::pair<double, double>& q, double w) {
-    return w == kMeanOnly ? q.second : q.first + w * q.second;
+  auto score = [&](const VertexQuality& q, double w) {
+    return w == kMeanOnly ? q.mean : q.min + w * q.mean;
   };
   static const std::array<Vec3, 14> dirs = [] {
     std::array<Vec3, 14> d;
@@ -736,16 +753,16 @@ int64_t local_max_min(const Problem& prob, std::vector<Vec3>& pts, const Untangl
     const double l = count > 0 ? len / count : 0.0;
     std::vector<HexOfVertex> hs;
     hexes_of(v, hs);
-    std::pair<double, double> cur = vertex_quality(pts[v], hs);
+    VertexQuality cur = vertex_quality(pts[v], hs, -1, -std::numeric_limits<double>::infinity());
     int32_t moved = 0;
     double step = 0.1 * l;
     for (int it = 0; it < 200 && step > stop * l; ++it) {
       const Vec3 old = pts[v];
       int best = -1;
-      std::pair<double, double> best_q = cur;
+      VertexQuality best_q = cur;
       for (int d = 0; d < 14; ++d) {
-        const std::pair<double, double> q = vertex_quality(old + step * dirs[d], hs);
-        if (q.first >= cur.first && score(q, w) > score(best_q, w)) best_q = q, best = d;
+        const VertexQuality q = vertex_quality(old + step * dirs[d], hs, cur.worst, cur.min);
+        if (q.min >= cur.min && score(q, w) > score(best_q, w)) best_q = q, best = d;
       }
       if (best >= 0) {
         pts[v] = old + step * dirs[best];
