@@ -166,12 +166,17 @@ struct Problem {
     ++evaluations;
     corner_evaluations += num_corners() + num_centres;
     set_positions(x);
+    // kernel.hex of hex h at pos, its 8 point gradients into gh; m takes the min of its terms
+    auto hex_energy = [&](int32_t h, Vec3 (&gh)[8], double& m) {
+      Vec3 p[8];
+      for (int k = 0; k < 8; ++k) p[k] = pos[hexes[h][k]], gh[k].setZero();
+      return kernel.hex(p, hex_mask[h], gh, m);
+    };
     if (abandon_infinite)
       for (int32_t h : suspects) {
-        Vec3 p[8], gh[8];
-        for (int k = 0; k < 8; ++k) p[k] = pos[hexes[h][k]], gh[k].setZero();
+        Vec3 gh[8];
         double m = kInf;
-        if (kernel.hex(p, hex_mask[h], gh, m) == kInf) return kInf;
+        if (hex_energy(h, gh, m) == kInf) return kInf;
       }
     const int32_t nb = num_blocks(), nh = num_hexes();
     std::atomic<bool> infinite{false};
@@ -185,9 +190,8 @@ struct Problem {
         double s = 0.0, m = kInf;
         const int32_t end = std::min(nh, (b + 1) * kBlock);
         for (int32_t h = b * kBlock; h < end; ++h) {
-          Vec3 p[8], gh[8];
-          for (int k = 0; k < 8; ++k) p[k] = pos[hexes[h][k]], gh[k].setZero();
-          const double e = kernel.hex(p, hex_mask[h], gh, m);
+          Vec3 gh[8];
+          const double e = hex_energy(h, gh, m);
           s += e;
           for (int k = 0; k < 8; ++k) hex_g[8 * static_cast<size_t>(h) + k] = gh[k];
           if (e == kInf && block_infinite[b] < 0) {
@@ -200,8 +204,6 @@ struct Problem {
         if (s == kInf) infinite.store(true, std::memory_order_relaxed);
       }
     });
-    double total = 0.0;
-    for (int32_t b = 0; b < nb; ++b) total += block_sum[b];
     if (abandon_infinite && infinite.load(std::memory_order_relaxed)) {
       for (int32_t b = 0; b < nb; ++b)
         if (block_infinite[b] >= 0) {
@@ -214,6 +216,8 @@ struct Problem {
         }
       return kInf;
     }
+    double total = 0.0;
+    for (int32_t b = 0; b < nb; ++b) total += block_sum[b];
     const int32_t nu = static_cast<int32_t>(free_point.size());
     tbb::parallel_for(tbb::blocked_range<int32_t>(0, nu, 1024), [&](const tbb::blocked_range<int32_t>& r) {
       for (int32_t u = r.begin(); u != r.end(); ++u) {
