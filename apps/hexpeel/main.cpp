@@ -329,8 +329,9 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0, 100000))->capture_default_str();
   bool no_mean_sweep = false;
   mesh->add_flag("--no-mean-sweep", no_mean_sweep,
-                 "skip the local sweep over every interior vertex that ends the optimization "
-                 "(it raises the mean scaled Jacobian: screw2 0.472 -> 0.513; faster without)");
+                 "skip the local sweeps over every interior vertex that end the optimization "
+                 "(they raise the mean scaled Jacobian: screw2 0.521 -> 0.575; a 10k-hex jittered "
+                 "sphere untangles in 0.6 s without them, 1.2 s with)");
   std::string solver = "lbfgs";
   mesh->add_option("--solver", solver,
                    "untangling minimizer: lbfgs (L-BFGS) or newton (projected Newton with a "

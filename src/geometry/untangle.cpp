@@ -668,6 +668,7 @@ int64_t local_max_min(const Problem& prob, std::vector<Vec3>& pts, const Untangl
   const std::vector<Hex>& hexes = prob.hexes;
   const int32_t nh = static_cast<int32_t>(hexes.size());
   const int32_t np = static_cast<int32_t>(pts.size());
+  if (nh == 0) return 0;
   // The hexes of free point v: slots inc_slot[i] / 8 for i in the range of its unknown.
   auto first = [&](int32_t v) { return prob.inc_start[prob.free_index[v]]; };
   auto last = [&](int32_t v) { return prob.inc_start[prob.free_index[v] + 1]; };
@@ -779,14 +780,68 @@ int64_t local_max_min(const Problem& prob, std::vector<Vec3>& pts, const Untangl
     return moved;
   };
   std::vector<double> sj(nh);
-  std::vector<int32_t> color(np, -1), moved;
-  std::vector<uint8_t> used, in_worst(np, 0);
-  int64_t moves = 0;
-  for (int sweep = 0; sweep < params.local_sweeps; ++sweep) {
+  // The scaled Jacobians of all hexes into sj; their minimum and mean (summed in hex order: the
+  // same for any thread count).
+  auto measure = [&](double& sj_min, double& sj_mean) {
     tbb::parallel_for(tbb::blocked_range<int32_t>(0, nh, 512),
                       [&](const tbb::blocked_range<int32_t>& r) {
                         for (int32_t h = r.begin(); h != r.end(); ++h) sj[h] = hex_sj(h);
                       });
+    sj_min = *std::min_element(sj.begin(), sj.end());
+    sj_mean = std::accumulate(sj.begin(), sj.end(), 0.0) / nh;
+  };
+  // The free vertices without skip[v], coloured greedily in id order so that no two of a colour
+  // share a hex, sorted by colour (stable); color[v] receives v's colour.
+  std::vector<int32_t> color(np, -1), moved;
+  std::vector<uint8_t> used;
+  auto colour = [&](const std::vector<uint8_t>& skip) {
+    std::vector<int32_t> verts;
+    std::fill(color.begin(), color.end(), -1);
+    int32_t colors = 0;
+    for (int32_t v = 0; v < np; ++v) {
+      if (prob.free_index[v] < 0 || skip[v]) continue;
+      used.assign(colors + 1, 0);
+      for (int32_t j = first(v); j < last(v); ++j)
+        for (int32_t w : hexes[prob.inc_slot[j] / 8])
+          if (color[w] >= 0) used[color[w]] = 1;
+      int32_t c = 0;
+      while (used[c]) ++c;
+      color[v] = c;
+      colors = std::max(colors, c + 1);
+      verts.push_back(v);
+    }
+    std::stable_sort(verts.begin(), verts.end(),
+                     [&](int32_t a, int32_t b) { return color[a] < color[b]; });
+    return verts;
+  };
+  // Searches the vertices of `verts` (sorted by colour) for the mean alone, down to steps of
+  // `stop` times their scale: colour after colour, the vertices of a colour in parallel (they
+  // share no hex, so each reads only hexes no other one moves). Returns the moves.
+  auto sweep_colours = [&](const std::vector<int32_t>& verts, double stop) {
+    moved.assign(verts.size(), 0);
+    for (size_t b = 0; b < verts.size();) {
+      size_t e = b;
+      while (e < verts.size() && color[verts[e]] == color[verts[b]]) ++e;
+      tbb::parallel_for(tbb::blocked_range<size_t>(b, e, 4),
+                        [&](const tbb::blocked_range<size_t>& r) {
+                          for (size_t i = r.begin(); i != r.end(); ++i)
+                            moved[i] = search(verts[i], stop, kMeanOnly);
+                        });
+      b = e;
+    }
+    return std::accumulate(moved.begin(), moved.end(), int64_t{0});
+  };
+  std::vector<uint8_t> in_worst(np, 0);
+  int64_t moves = 0;
+  double last_min = 0.0, last_mean = 0.0;
+  const int max_sweeps = std::max(params.local_sweeps, params.local_sweeps_max);
+  for (int sweep = 0; sweep < max_sweeps; ++sweep) {
+    double sj_min, sj_mean;
+    measure(sj_min, sj_mean);
+    if (sweep >= params.local_sweeps && sj_min - last_min < params.local_sweep_min_gain &&
+        sj_mean - last_mean < params.local_sweep_mean_gain)
+      break;
+    last_min = sj_min, last_mean = sj_mean;
     std::vector<int32_t> order(nh);
     std::iota(order.begin(), order.end(), 0);
     const int32_t k = std::min(nh, params.local_hexes);
@@ -802,41 +857,24 @@ int64_t local_max_min(const Problem& prob, std::vector<Vec3>& pts, const Untangl
         if (prob.free_index[v] >= 0 && !in_worst[v]) in_worst[v] = 1, verts.push_back(v);
     int64_t sweep_moves = 0;
     for (int32_t v : verts) sweep_moves += search(v, 1e-3, params.local_mean_weight);
-    // 2. With local_all, every other free vertex, coloured greedily in id order so that no two of
-    // a colour share a hex; colour after colour, the vertices of a colour in parallel.
-    verts.clear();
-    if (params.local_all) {
-      std::fill(color.begin(), color.end(), -1);
-      int32_t colors = 0;
-      for (int32_t v = 0; v < np; ++v) {
-        if (prob.free_index[v] < 0 || in_worst[v]) continue;
-        used.assign(colors + 1, 0);
-        for (int32_t j = first(v); j < last(v); ++j)
-          for (int32_t w : hexes[prob.inc_slot[j] / 8])
-            if (color[w] >= 0) used[color[w]] = 1;
-        int32_t c = 0;
-        while (used[c]) ++c;
-        color[v] = c;
-        colors = std::max(colors, c + 1);
-        verts.push_back(v);
-      }
-      std::stable_sort(verts.begin(), verts.end(),
-                       [&](int32_t a, int32_t b) { return color[a] < color[b]; });
-    }
-    moved.assign(verts.size(), 0);
-    for (size_t b = 0; b < verts.size();) {
-      size_t e = b;
-      while (e < verts.size() && color[verts[e]] == color[verts[b]]) ++e;
-      tbb::parallel_for(tbb::blocked_range<size_t>(b, e, 4),
-                        [&](const tbb::blocked_range<size_t>& r) {
-                          for (size_t i = r.begin(); i != r.end(); ++i)
-                            moved[i] = search(verts[i], params.local_all_stop, kMeanOnly);
-                        });
-      b = e;
-    }
-    sweep_moves += std::accumulate(moved.begin(), moved.end(), int64_t{0});
+    // 2. With local_all, every other free vertex, by colours.
+    if (params.local_all) sweep_moves += sweep_colours(colour(in_worst), params.local_all_stop);
     moves += sweep_moves;
     if (sweep_moves == 0) break;
+  }
+  // 3. The mean sweeps: every free vertex, by colours, with finer steps, while the mean rises.
+  // Their steps never lower a vertex's own minimum, so the minimum reached above stays.
+  if (params.local_all && params.local_polish_stop > 0.0) {
+    const std::vector<int32_t> verts = colour(std::vector<uint8_t>(np, 0));
+    measure(last_min, last_mean);
+    for (int sweep = 0; sweep < max_sweeps; ++sweep) {
+      const int64_t sweep_moves = sweep_colours(verts, params.local_polish_stop);
+      moves += sweep_moves;
+      double sj_min, sj_mean;
+      measure(sj_min, sj_mean);
+      if (sweep_moves == 0 || sj_mean - last_mean < params.local_sweep_mean_gain) break;
+      last_mean = sj_mean;
+    }
   }
   return moves;
 }

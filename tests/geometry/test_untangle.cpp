@@ -511,6 +511,25 @@ TEST(GeometryPipeline, SweepsOverAllVerticesRaiseTheMean) {
   EXPECT_EQ(b.quality.boundary_matches_surface, true);
 }
 
+// The mean sweeps that end the local sweeps (local_polish_stop): every accepted step raises the
+// mean of the moved vertex's hexes and keeps their minimum, so against the same run without them
+// the mean is higher and the minimum not lower (measured: mean 0.76134 -> 0.76170, the same min;
+// the larger gains come on curved solids such as screw2, 0.557 -> 0.575).
+TEST(GeometryUntangle, MeanSweepsRaiseTheMeanAndKeepTheMinimum) {
+  Generated g = testing::jittered(testing::cubed_sphere_equiangular(6), 5, 0.2);
+  UntangleParams p;
+  p.local_polish_stop = 0.0;
+  UntangleResult a = run_untangle(g.known_mesh, surface_fixed(g), p);
+  UntangleResult b = run_untangle(g.known_mesh, surface_fixed(g));
+  const QualityReport qa = run_quality(a.mesh), qb = run_quality(b.mesh);
+  EXPECT_GT(b.stats.local_moves, a.stats.local_moves);
+  EXPECT_GE(qb.sj_min, qa.sj_min);
+  EXPECT_GT(qb.sj_mean, qa.sj_mean + 2e-4);
+  EXPECT_EQ(qb.sj_count_nonpositive, 0);
+  for (int32_t v = 0; v < g.surface.num_points(); ++v)
+    ASSERT_EQ(b.mesh.points[v], g.known_mesh.points[v]) << "vertex " << v;
+}
+
 // Exact inward-direction test: a convex corner has one, a saddle with opposite normals has none,
 // and a star whose best direction is fixed by three normals (the mean, each normal and each pair
 // fail) has one.
