@@ -7,7 +7,8 @@
 //                [--method original|kremer] [--no-zero-volume] [--no-enclosed] [--no-concave]
 //                [--no-false-positive] [--no-concave-waits] [--strict-intrusion]
 //                [--pillow auto|all|none] [--no-untangle] [--no-optimize]
-//                [--polish-iterations N] [--no-mean-sweep] [--solver lbfgs|newton] [--alternatives N]
+//                [--polish-iterations N] [--quality-passes N] [--no-mean-sweep]
+//                [--solver lbfgs|newton] [--alternatives N]
 //                [--alternatives-always] [--threads N] [--quiet]
 //   hexpeel quality MESH [--surface IN] [--json FILE] [--threads N]
 //
@@ -327,6 +328,12 @@ int main(int argc, char** argv) {
                    "L-BFGS iterations of the mean polish near the end of the optimization (raises the "
                    "mean scaled Jacobian and never lowers the minimum; 0 = skip it, for speed)")
       ->check(CLI::Range(0, 100000))->capture_default_str();
+  mesh->add_option("--quality-passes", params.untangle.quality_passes,
+                   "passes of the optimization (restarts, mean polish, max-min sweeps), each from "
+                   "where the last left off, while one raises the minimum scaled Jacobian by 1e-3; "
+                   "a pass that lowers the minimum, or the mean by more than it raises the minimum, "
+                   "is undone (1 = one pass, faster)")
+      ->check(CLI::Range(1, 100))->capture_default_str();
   bool no_mean_sweep = false;
   mesh->add_flag("--no-mean-sweep", no_mean_sweep,
                  "skip the local sweeps over every interior vertex that end the optimization "

@@ -175,6 +175,10 @@ struct UntangleParams {
   /// 0.353; 9% fewer corner evaluations). 10 rounds gained less than 0.01 more on 6 surfaces for
   /// another 4% and lowered pierrot's mean to 0.777.
   int max_quality_rounds = 8;
+  /// Phase 2 passes (>= 1): restarts, mean polish and max-min sweeps, repeated from where the
+  /// sweeps left the points while a pass raises the minimum corner s by 1e-3 or more; a pass that
+  /// ends with a lower minimum is undone. The mean sweeps run once, after the last pass.
+  int quality_passes = 3;
   /// At most this many L-BFGS iterations per phase 2 restart (fewer when restart_delta stops the
   /// run), 1..100000.
   int max_quality_inner = 150;
@@ -218,6 +222,7 @@ struct UntangleStats {
   bool optimize_reverted = false;  ///< phase 2 made the minimum worse and was undone
   bool mean_polish_kept = false;   ///< phase 2's mean polish ran and kept the minimum
   int64_t local_moves = 0;         ///< steps taken by phase 2's local max-min sweeps
+  int32_t quality_passes = 0;      ///< phase 2 passes run (an undone last one included)
   double final_eps = 0.0;
   double time_s = 0.0;
 };

@@ -663,8 +663,10 @@ int32_t minimize_region(Problem& prob, Problem& sub, const std::vector<uint8_t>&
 /// directly. With local_all, every other free vertex follows, in parallel by colours (no two
 /// vertices of a colour share a hex, so a vertex's search reads only hexes no other vertex of its
 /// colour touches): the result is the same for any thread count. The global minimum never drops.
-/// Returns the moves.
-int64_t local_max_min(const Problem& prob, std::vector<Vec3>& pts, const UntangleParams& params) {
+/// `max_min_sweeps` runs these sweeps, `mean_sweeps` the mean sweeps (local_polish_stop) after
+/// them. Returns the moves.
+int64_t local_max_min(const Problem& prob, std::vector<Vec3>& pts, const UntangleParams& params,
+                      bool max_min_sweeps, bool mean_sweeps) {
   const std::vector<Hex>& hexes = prob.hexes;
   const int32_t nh = static_cast<int32_t>(hexes.size());
   const int32_t np = static_cast<int32_t>(pts.size());
@@ -835,7 +837,7 @@ int64_t local_max_min(const Problem& prob, std::vector<Vec3>& pts, const Untangl
   int64_t moves = 0;
   double last_min = 0.0, last_mean = 0.0;
   const int max_sweeps = std::max(params.local_sweeps, params.local_sweeps_max);
-  for (int sweep = 0; sweep < max_sweeps; ++sweep) {
+  for (int sweep = 0; max_min_sweeps && sweep < max_sweeps; ++sweep) {
     double sj_min, sj_mean;
     measure(sj_min, sj_mean);
     if (sweep >= params.local_sweeps && sj_min - last_min < params.local_sweep_min_gain &&
@@ -864,7 +866,7 @@ int64_t local_max_min(const Problem& prob, std::vector<Vec3>& pts, const Untangl
   }
   // 3. The mean sweeps: every free vertex, by colours, with finer steps, while the mean rises.
   // Their steps never lower a vertex's own minimum, so the minimum reached above stays.
-  if (params.local_all && params.local_polish_stop > 0.0) {
+  if (mean_sweeps && params.local_all && params.local_polish_stop > 0.0) {
     const std::vector<int32_t> verts = colour(std::vector<uint8_t>(np, 0));
     measure(last_min, last_mean);
     for (int sweep = 0; sweep < max_sweeps; ++sweep) {
@@ -1036,81 +1038,112 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
     Problem sub;
     std::vector<uint8_t> in_region;
     std::vector<double> hex_s;
-    for (int round = 0; round < params.max_quality_rounds; ++round) {
-      k.s_ref = smin;
-      // Positive meshes stay positive; a mesh with inverted corners may not get worse.
-      k.floor = smin > 0 ? 0.0 : smin - 1e-12;
-      if (focus) {
-        // Only corners with s < s_ref + focus_width weigh in the smoothed minimum (the others'
-        // exp terms are below exp(-beta focus_width)): free the vertices of their hexes and
-        // focus_rings rings of hexes around them, pin the rest where it is.
-        prob.hex_min_value(hex_s);
-        in_region.assign(prob.base.size(), 0);
-        for (int32_t h = 0; h < prob.num_hexes(); ++h)
-          if (hex_s[h] < smin + params.focus_width)
-            for (int32_t v : prob.hexes[h]) in_region[v] = 1;
-        for (int ring = 0; ring < params.focus_rings; ++ring) {
-          std::vector<uint8_t> grown = in_region;
-          for (const Hex& h : prob.hexes) {
-            bool touches = false;
-            for (int32_t v : h) touches |= in_region[v] != 0;
-            if (touches)
-              for (int32_t v : h) grown[v] = 1;
-          }
-          in_region.swap(grown);
-        }
-        std::vector<uint8_t> sub_fixed(prob.base.size(), 1);
-        for (int32_t v : prob.free_point) sub_fixed[v] = in_region[v] ? 0 : 1;
-        minimize_region(prob, sub, sub_fixed, k, x, params, params.max_quality_inner,
-                        params.restart_delta, res.stats.optimize);
-      } else {
-        res.stats.optimize.iterations += minimize(prob, k, x, params, params.max_quality_inner,
-                                                  StopRule::delta, params.restart_delta);
-      }
-      prob.evaluate(x, g, k);
-      const double s = prob.min_corner_value();
-      ++res.stats.optimize.rounds;
-      ctx.report("optimize", (round + 1.0) / params.max_quality_rounds);
-      const bool done = s - smin < 1e-3;
-      smin = std::max(smin, s);
-      if (done) break;
-    }
-    if (params.max_mean_inner > 0 && params.mean_weight > 0.0 && params.mean_pin > 0.0 &&
-        smin > 0.0) {
-      // Mean polish: the restarts' objective plus a flat exponential that weighs every corner
-      // nearly alike. The hexes within mean_pin of the minimum keep all 8 vertices where they
-      // are, every other corner must stay above the minimum, and the polish is undone if the
-      // minimum still ends lower.
-      const Eigen::VectorXd x_min = x;
-      const double s_now = prob.min_corner_value();  // at x (a last restart may have lost a bit)
-      prob.hex_min_value(hex_s);
-      std::vector<uint8_t> sub_fixed(prob.base.size(), 1);
-      for (int32_t v : prob.free_point) sub_fixed[v] = 0;
-      for (int32_t h = 0; h < prob.num_hexes(); ++h)
-        if (hex_s[h] < s_now + params.mean_pin)
-          for (int32_t v : prob.hexes[h]) sub_fixed[v] = 1;
-      QualityKernel km = k;
-      km.s_ref = s_now;
-      km.floor = s_now;  // the hexes it evaluates start at >= s_now + mean_pin (the rest pinned)
-      km.mean_beta = params.mean_beta;
-      km.mean_weight = params.mean_weight;
-      const int32_t ns = minimize_region(prob, sub, sub_fixed, km, x, params,
-                                         params.max_mean_inner, params.inner_delta,
-                                         res.stats.optimize);
-      prob.evaluate(x, g, k);
-      res.stats.mean_polish_kept = ns > 0 && prob.min_corner_value() >= s_now;
-      if (!res.stats.mean_polish_kept) {
-        x = x_min;
-        prob.evaluate(x, g, k);
-      }
-    }
-    if (params.local_sweeps > 0 && params.local_hexes > 0) {
+    // Sweeps on the points of x: the max-min sweeps and / or the mean sweeps.
+    const bool sweeps = params.local_sweeps > 0 && params.local_hexes > 0;
+    auto run_sweeps = [&](bool max_min_sweeps, bool mean_sweeps) {
       std::vector<Vec3> pts = prob.base;
       const int32_t nu = static_cast<int32_t>(prob.free_point.size());
       for (int32_t u = 0; u < nu; ++u) pts[prob.free_point[u]] = x.segment<3>(3 * u);
-      res.stats.local_moves = local_max_min(prob, pts, params);
+      res.stats.local_moves += local_max_min(prob, pts, params, max_min_sweeps, mean_sweeps);
       for (int32_t u = 0; u < nu; ++u) x.segment<3>(3 * u) = pts[prob.free_point[u]];
+    };
+    // The mean over the hexes of their minimum term at the last evaluation's points.
+    auto mean_hex_value = [&] {
+      prob.hex_min_value(hex_s);
+      return std::accumulate(hex_s.begin(), hex_s.end(), 0.0) / std::max<size_t>(1, hex_s.size());
+    };
+    // Passes: restarts, mean polish, max-min sweeps. A later pass starts the restarts from where
+    // the sweeps left the points; it is undone if it ends with a lower minimum, or lowers the
+    // mean more than it raises the minimum (weighed as the sweeps weigh them, local_mean_weight),
+    // and the passes stop once one raises the minimum by less than 1e-3.
+    const int passes = std::max(1, params.quality_passes);
+    Eigen::VectorXd x_pass;
+    double mean_pass = 0.0;
+    for (int pass = 0; pass < passes; ++pass) {
+      const double s_pass = smin;
+      if (pass > 0) x_pass = x, mean_pass = mean_hex_value();
+      for (int round = 0; round < params.max_quality_rounds; ++round) {
+        k.s_ref = smin;
+        // Positive meshes stay positive; a mesh with inverted corners may not get worse.
+        k.floor = smin > 0 ? 0.0 : smin - 1e-12;
+        if (focus) {
+          // Only corners with s < s_ref + focus_width weigh in the smoothed minimum (the others'
+          // exp terms are below exp(-beta focus_width)): free the vertices of their hexes and
+          // focus_rings rings of hexes around them, pin the rest where it is.
+          prob.hex_min_value(hex_s);
+          in_region.assign(prob.base.size(), 0);
+          for (int32_t h = 0; h < prob.num_hexes(); ++h)
+            if (hex_s[h] < smin + params.focus_width)
+              for (int32_t v : prob.hexes[h]) in_region[v] = 1;
+          for (int ring = 0; ring < params.focus_rings; ++ring) {
+            std::vector<uint8_t> grown = in_region;
+            for (const Hex& h : prob.hexes) {
+              bool touches = false;
+              for (int32_t v : h) touches |= in_region[v] != 0;
+              if (touches)
+                for (int32_t v : h) grown[v] = 1;
+            }
+            in_region.swap(grown);
+          }
+          std::vector<uint8_t> sub_fixed(prob.base.size(), 1);
+          for (int32_t v : prob.free_point) sub_fixed[v] = in_region[v] ? 0 : 1;
+          minimize_region(prob, sub, sub_fixed, k, x, params, params.max_quality_inner,
+                          params.restart_delta, res.stats.optimize);
+        } else {
+          res.stats.optimize.iterations += minimize(prob, k, x, params, params.max_quality_inner,
+                                                    StopRule::delta, params.restart_delta);
+        }
+        prob.evaluate(x, g, k);
+        const double s = prob.min_corner_value();
+        ++res.stats.optimize.rounds;
+        ctx.report("optimize", (pass + (round + 1.0) / params.max_quality_rounds) / passes);
+        const bool done = s - smin < 1e-3;
+        smin = std::max(smin, s);
+        if (done) break;
+      }
+      if (params.max_mean_inner > 0 && params.mean_weight > 0.0 && params.mean_pin > 0.0 &&
+          smin > 0.0) {
+        // Mean polish: the restarts' objective plus a flat exponential that weighs every corner
+        // nearly alike. The hexes within mean_pin of the minimum keep all 8 vertices where they
+        // are, every other corner must stay above the minimum, and the polish is undone if the
+        // minimum still ends lower.
+        const Eigen::VectorXd x_min = x;
+        const double s_now = prob.min_corner_value();  // at x (a last restart may have lost a bit)
+        prob.hex_min_value(hex_s);
+        std::vector<uint8_t> sub_fixed(prob.base.size(), 1);
+        for (int32_t v : prob.free_point) sub_fixed[v] = 0;
+        for (int32_t h = 0; h < prob.num_hexes(); ++h)
+          if (hex_s[h] < s_now + params.mean_pin)
+            for (int32_t v : prob.hexes[h]) sub_fixed[v] = 1;
+        QualityKernel km = k;
+        km.s_ref = s_now;
+        km.floor = s_now;  // the hexes it evaluates start at >= s_now + mean_pin (the rest pinned)
+        km.mean_beta = params.mean_beta;
+        km.mean_weight = params.mean_weight;
+        const int32_t ns = minimize_region(prob, sub, sub_fixed, km, x, params,
+                                           params.max_mean_inner, params.inner_delta,
+                                           res.stats.optimize);
+        prob.evaluate(x, g, k);
+        res.stats.mean_polish_kept = ns > 0 && prob.min_corner_value() >= s_now;
+        if (!res.stats.mean_polish_kept) {
+          x = x_min;
+          prob.evaluate(x, g, k);
+        }
+      }
+      if (sweeps) run_sweeps(true, false);
+      prob.evaluate(x, g, k);
+      const double s_end = prob.min_corner_value();
+      ++res.stats.quality_passes;
+      if (pass > 0 && (s_end < s_pass || (s_end - s_pass) + params.local_mean_weight *
+                                                (mean_hex_value() - mean_pass) < 0.0)) {
+        x = x_pass;
+        prob.evaluate(x, g, k);
+        break;
+      }
+      smin = s_end;
+      if (s_end - s_pass < 1e-3) break;
     }
+    if (sweeps) run_sweeps(false, true);
     res.stats.optimize.evaluations += prob.evaluations - ev0;
     res.stats.optimize.corner_evaluations += prob.corner_evaluations - cev0;
     HexMesh before = res.mesh;

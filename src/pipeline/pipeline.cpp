@@ -387,6 +387,7 @@ nlohmann::json to_json(const MeshResult& r) {
                      {"optimize_reverted", u.optimize_reverted},
                      {"mean_polish_kept", u.mean_polish_kept},
                      {"local_moves", u.local_moves},
+                     {"quality_passes", u.quality_passes},
                      {"time_s", u.time_s}};
   }
   j["timings_s"] = {{"check", r.timings.check_s},
