@@ -149,8 +149,10 @@ struct UntangleParams {
   double local_all_stop = 3e-2;
   /// With local_all, the sweeps end with mean sweeps: every free vertex, by colours, searched for
   /// the mean alone down to steps of this times its scale, while a sweep raises the mean by
-  /// local_sweep_mean_gain or more (at most local_sweeps_max). A step never lowers the minimum of
-  /// the vertex's own hexes, so the minimum the sweeps reached stays (0 skips them; (0, 0.1]).
+  /// local_sweep_mean_gain or more (at most max(local_sweeps, local_sweeps_max) sweeps). A step
+  /// never lowers the minimum of the vertex's own hexes, so the minimum the sweeps reached stays;
+  /// like the other mean-only searches, they leave the vertices of hexes <= 0 where they are
+  /// (0 skips them; (0, 0.1]).
   double local_polish_stop = 3e-3;
   /// A sweep step must keep the minimum of the vertex's hexes and raise that minimum plus this
   /// times their mean (>= 0): a pure max-min (0) sacrificed the other hexes (thin plate: mean
@@ -176,8 +178,10 @@ struct UntangleParams {
   /// another 4% and lowered pierrot's mean to 0.777.
   int max_quality_rounds = 8;
   /// Phase 2 passes (>= 1): restarts, mean polish and max-min sweeps, repeated from where the
-  /// sweeps left the points while a pass raises the minimum corner s by 1e-3 or more; a pass that
-  /// ends with a lower minimum is undone. The mean sweeps run once, after the last pass.
+  /// sweeps left the points while a pass raises the minimum s over the active corner and centre
+  /// terms by 1e-3 or more. A later pass is undone, and ends the passes, when it lowers that
+  /// minimum, or when its gain in it plus local_mean_weight times its gain in the mean over the
+  /// hexes of their minimum active term is negative. The mean sweeps run once, after the passes.
   int quality_passes = 3;
   /// At most this many L-BFGS iterations per phase 2 restart (fewer when restart_delta stops the
   /// run), 1..100000.
@@ -220,8 +224,8 @@ struct UntangleStats {
   int32_t forced_nonpositive = 0;  ///< forced corners with det <= 0: no placement fixes them
   UntanglePhaseStats untangle, optimize;
   bool optimize_reverted = false;  ///< phase 2 made the minimum worse and was undone
-  bool mean_polish_kept = false;   ///< phase 2's mean polish ran and kept the minimum
-  int64_t local_moves = 0;         ///< steps taken by phase 2's local max-min sweeps
+  bool mean_polish_kept = false;   ///< a mean polish of phase 2 ran and kept the minimum
+  int64_t local_moves = 0;         ///< steps of phase 2's local sweeps (undone passes' left out)
   int32_t quality_passes = 0;      ///< phase 2 passes run (an undone last one included)
   double final_eps = 0.0;
   double time_s = 0.0;

@@ -670,7 +670,7 @@ int64_t local_max_min(const Problem& prob, std::vector<Vec3>& pts, const Untangl
   const std::vector<Hex>& hexes = prob.hexes;
   const int32_t nh = static_cast<int32_t>(hexes.size());
   const int32_t np = static_cast<int32_t>(pts.size());
-  if (nh == 0) return 0;
+  if (nh == 0 || params.local_sweeps <= 0 || params.local_hexes <= 0) return 0;
   // The hexes of free point v: slots inc_slot[i] / 8 for i in the range of its unknown.
   auto first = [&](int32_t v) { return prob.inc_start[prob.free_index[v]]; };
   auto last = [&](int32_t v) { return prob.inc_start[prob.free_index[v] + 1]; };
@@ -761,6 +761,9 @@ int64_t local_max_min(const Problem& prob, std::vector<Vec3>& pts, const Untangl
     std::vector<HexOfVertex> hs;
     hexes_of(v, hs);
     VertexQuality cur = vertex_quality(pts[v], hs, -1, -std::numeric_limits<double>::infinity());
+    // A step may take any hex of v down to v's minimum: for the mean alone, not when that
+    // minimum is a hex <= 0 (a forced corner, say), which would let the others follow it.
+    if (w == kMeanOnly && !(cur.min > 0.0)) return 0;
     int32_t moved = 0;
     double step = 0.1 * l;
     for (int it = 0; it < 200 && step > stop * l; ++it) {
@@ -1059,9 +1062,14 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
     const int passes = std::max(1, params.quality_passes);
     Eigen::VectorXd x_pass;
     double mean_pass = 0.0;
+    bool kept_pass = false;    // mean_polish_kept and local_moves at the pass's start, for an undo
+    int64_t moves_pass = 0;
     for (int pass = 0; pass < passes; ++pass) {
       const double s_pass = smin;
-      if (pass > 0) x_pass = x, mean_pass = mean_hex_value();
+      if (pass > 0) {
+        x_pass = x, mean_pass = mean_hex_value();
+        kept_pass = res.stats.mean_polish_kept, moves_pass = res.stats.local_moves;
+      }
       for (int round = 0; round < params.max_quality_rounds; ++round) {
         k.s_ref = smin;
         // Positive meshes stay positive; a mesh with inverted corners may not get worse.
@@ -1124,8 +1132,9 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
                                            params.max_mean_inner, params.inner_delta,
                                            res.stats.optimize);
         prob.evaluate(x, g, k);
-        res.stats.mean_polish_kept = ns > 0 && prob.min_corner_value() >= s_now;
-        if (!res.stats.mean_polish_kept) {
+        if (ns > 0 && prob.min_corner_value() >= s_now) {
+          res.stats.mean_polish_kept = true;
+        } else {
           x = x_min;
           prob.evaluate(x, g, k);
         }
@@ -1138,6 +1147,7 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
                                                 (mean_hex_value() - mean_pass) < 0.0)) {
         x = x_pass;
         prob.evaluate(x, g, k);
+        res.stats.mean_polish_kept = kept_pass, res.stats.local_moves = moves_pass;
         break;
       }
       smin = s_end;
