@@ -330,7 +330,7 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0, 100000))->capture_default_str();
   mesh->add_option("--quality-passes", params.untangle.quality_passes,
                    "passes of the optimization (restarts, mean polish, max-min sweeps), each from "
-                   "where the last left off, while one raises the minimum scaled Jacobian by 1e-3; "
+                   "where the last left off, while one raises the minimum scaled Jacobian by 5e-3; "
                    "a pass that lowers the minimum, or the mean by more than it raises the minimum, "
                    "is undone (1 = one pass, faster)")
       ->check(CLI::Range(1, 100))->capture_default_str();

@@ -1058,7 +1058,7 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
     // Passes: restarts, mean polish, max-min sweeps. A later pass starts the restarts from where
     // the sweeps left the points; it is undone if it ends with a lower minimum, or lowers the
     // mean more than it raises the minimum (weighed as the sweeps weigh them, local_mean_weight),
-    // and the passes stop once one raises the minimum by less than 1e-3.
+    // and the passes stop once one raises the minimum by less than quality_pass_gain.
     const int passes = std::max(1, params.quality_passes);
     Eigen::VectorXd x_pass;
     double mean_pass = 0.0;
@@ -1151,7 +1151,7 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
         break;
       }
       smin = s_end;
-      if (s_end - s_pass < 1e-3) break;
+      if (s_end - s_pass < params.quality_pass_gain) break;
     }
     if (sweeps) run_sweeps(false, true);
     res.stats.optimize.evaluations += prob.evaluations - ev0;
