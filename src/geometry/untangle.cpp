@@ -1055,21 +1055,9 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
       prob.hex_min_value(hex_s);
       return std::accumulate(hex_s.begin(), hex_s.end(), 0.0) / std::max<size_t>(1, hex_s.size());
     };
-    // Passes: restarts, mean polish, max-min sweeps. A later pass starts the restarts from where
-    // the sweeps left the points; it is undone if it ends with a lower minimum, or lowers the
-    // mean more than it raises the minimum (weighed as the sweeps weigh them, local_mean_weight),
-    // and the passes stop once one raises the minimum by less than quality_pass_gain.
-    const int passes = std::max(1, params.quality_passes);
-    Eigen::VectorXd x_pass;
-    double mean_pass = 0.0;
-    bool kept_pass = false;    // mean_polish_kept and local_moves at the pass's start, for an undo
-    int64_t moves_pass = 0;
-    for (int pass = 0; pass < passes; ++pass) {
-      const double s_pass = smin;
-      if (pass > 0) {
-        x_pass = x, mean_pass = mean_hex_value();
-        kept_pass = res.stats.mean_polish_kept, moves_pass = res.stats.local_moves;
-      }
+    // Restarts (re-centred on the new minimum) from x until one gains less than 1e-3; pass and
+    // passes place the progress report.
+    auto run_restarts = [&](int pass, int passes) {
       for (int round = 0; round < params.max_quality_rounds; ++round) {
         k.s_ref = smin;
         // Positive meshes stay positive; a mesh with inverted corners may not get worse.
@@ -1109,36 +1097,56 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
         smin = std::max(smin, s);
         if (done) break;
       }
-      if (params.max_mean_inner > 0 && params.mean_weight > 0.0 && params.mean_pin > 0.0 &&
-          smin > 0.0) {
-        // Mean polish: the restarts' objective plus a flat exponential that weighs every corner
-        // nearly alike. The hexes within mean_pin of the minimum keep all 8 vertices where they
-        // are, every other corner must stay above the minimum, and the polish is undone if the
-        // minimum still ends lower.
-        const Eigen::VectorXd x_min = x;
-        const double s_now = prob.min_corner_value();  // at x (a last restart may have lost a bit)
-        prob.hex_min_value(hex_s);
-        std::vector<uint8_t> sub_fixed(prob.base.size(), 1);
-        for (int32_t v : prob.free_point) sub_fixed[v] = 0;
-        for (int32_t h = 0; h < prob.num_hexes(); ++h)
-          if (hex_s[h] < s_now + params.mean_pin)
-            for (int32_t v : prob.hexes[h]) sub_fixed[v] = 1;
-        QualityKernel km = k;
-        km.s_ref = s_now;
-        km.floor = s_now;  // the hexes it evaluates start at >= s_now + mean_pin (the rest pinned)
-        km.mean_beta = params.mean_beta;
-        km.mean_weight = params.mean_weight;
-        const int32_t ns = minimize_region(prob, sub, sub_fixed, km, x, params,
-                                           params.max_mean_inner, params.inner_delta,
-                                           res.stats.optimize);
+    };
+    // Mean polish: the restarts' objective plus a flat exponential that weighs every corner
+    // nearly alike. The hexes within mean_pin of the minimum keep all 8 vertices where they are,
+    // every other corner must stay above the minimum, and the polish is undone if the minimum
+    // still ends lower.
+    auto run_polish = [&] {
+      if (params.max_mean_inner <= 0 || !(params.mean_weight > 0.0) || !(params.mean_pin > 0.0) ||
+          !(smin > 0.0))
+        return;
+      const Eigen::VectorXd x_min = x;
+      const double s_now = prob.min_corner_value();  // at x (a last restart may have lost a bit)
+      prob.hex_min_value(hex_s);
+      std::vector<uint8_t> sub_fixed(prob.base.size(), 1);
+      for (int32_t v : prob.free_point) sub_fixed[v] = 0;
+      for (int32_t h = 0; h < prob.num_hexes(); ++h)
+        if (hex_s[h] < s_now + params.mean_pin)
+          for (int32_t v : prob.hexes[h]) sub_fixed[v] = 1;
+      QualityKernel km = k;
+      km.s_ref = s_now;
+      km.floor = s_now;  // the hexes it evaluates start at >= s_now + mean_pin (the rest pinned)
+      km.mean_beta = params.mean_beta;
+      km.mean_weight = params.mean_weight;
+      const int32_t ns = minimize_region(prob, sub, sub_fixed, km, x, params,
+                                         params.max_mean_inner, params.inner_delta,
+                                         res.stats.optimize);
+      prob.evaluate(x, g, k);
+      if (ns > 0 && prob.min_corner_value() >= s_now) {
+        res.stats.mean_polish_kept = true;
+      } else {
+        x = x_min;
         prob.evaluate(x, g, k);
-        if (ns > 0 && prob.min_corner_value() >= s_now) {
-          res.stats.mean_polish_kept = true;
-        } else {
-          x = x_min;
-          prob.evaluate(x, g, k);
-        }
       }
+    };
+    // Passes: restarts, mean polish, max-min sweeps. A later pass starts the restarts from where
+    // the sweeps left the points; it is undone if it ends with a lower minimum, or lowers the
+    // mean more than it raises the minimum (weighed as the sweeps weigh them, local_mean_weight),
+    // and the passes stop once one raises the minimum by less than quality_pass_gain.
+    const int passes = std::max(1, params.quality_passes);
+    Eigen::VectorXd x_pass;
+    double mean_pass = 0.0;
+    bool kept_pass = false;    // mean_polish_kept and local_moves at the pass's start, for an undo
+    int64_t moves_pass = 0;
+    for (int pass = 0; pass < passes; ++pass) {
+      const double s_pass = smin;
+      if (pass > 0) {
+        x_pass = x, mean_pass = mean_hex_value();
+        kept_pass = res.stats.mean_polish_kept, moves_pass = res.stats.local_moves;
+      }
+      run_restarts(pass, passes);
+      run_polish();
       if (sweeps) run_sweeps(true, false);
       prob.evaluate(x, g, k);
       const double s_end = prob.min_corner_value();
