@@ -5,8 +5,9 @@
 //       full pipeline on each surface file (and with --family on generated surfaces): hexes,
 //       forced configurations, min/mean SJ after placement and after each phase, times.
 //   hexpeel_untangle_bench scaling [--sizes 10,22,46] [--threads N] [--solver newton|lbfgs]
-//                                  [--simplicial] [--no-mean-sweep]
+//                                  [--simplicial] [--no-mean-sweep] [--final-polish-runs N]
 //       the optimizer alone on jittered equiangular cubed spheres of n^3 hexes: time per phase,
+//       the mean scaled Jacobian at the end,
 //       iterations / evaluations (Newton: also factorizations and the time spent assembling,
 //       factorizing and solving), corner-evaluations per second (one corner term with its
 //       gradient; phase 2 evaluates only its focus region, so evaluations differ in size).
@@ -81,10 +82,14 @@ int main(int argc, char** argv) {
   scaling->add_option("--jitter", jitter, "jittered() amount")->capture_default_str();
   std::string solver = "lbfgs";
   bool simplicial = false, no_mean_sweep = false;
+  int up_final_polish_runs = UntangleParams{}.final_polish_runs;
   for (auto* sub : {mesh, scaling}) {
     sub->add_option("--solver", solver, "phase 1 minimizer: newton|lbfgs")->capture_default_str();
     sub->add_flag("--simplicial", simplicial, "Newton: CHOLMOD simplicial instead of supernodal");
     sub->add_flag("--no-mean-sweep", no_mean_sweep, "UntangleParams::local_all = false");
+    sub->add_option("--final-polish-runs", up_final_polish_runs,
+                    "UntangleParams::final_polish_runs (0 = skip the final polish)")
+        ->check(CLI::Range(0, 100))->capture_default_str();
   }
   CLI11_PARSE(app, argc, argv);
   UntangleParams up;
@@ -94,6 +99,7 @@ int main(int argc, char** argv) {
   }
   up.supernodal = !simplicial;
   up.local_all = !no_mean_sweep;
+  up.final_polish_runs = up_final_polish_runs;
   std::unique_ptr<tbb::global_control> gc;
   if (threads > 0)
     gc = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
@@ -140,8 +146,8 @@ int main(int argc, char** argv) {
   if (*scaling) {
     std::printf("solver %s%s\n\n| hexes | free vertices | forced (<=0) | placed min | "
                 "untangle: rounds/iters/evals/factorizations | untangle time (solve) | min | "
-                "optimize: rounds/evals/time | min | total | corner-evals/s |\n"
-                "|---|---|---|---|---|---|---|---|---|---|---|\n", solver.c_str(),
+                "optimize: rounds/evals/time | min | mean | total | corner-evals/s |\n"
+                "|---|---|---|---|---|---|---|---|---|---|---|---|\n", solver.c_str(),
                 solver == "newton" ? (simplicial ? " (simplicial)" : " (supernodal)") : "");
     for (int n : sizes) {
       testing::Generated g = testing::jittered(testing::cubed_sphere_equiangular(n), 7, jitter);
@@ -153,13 +159,14 @@ int main(int argc, char** argv) {
       const double corner_evals =
           static_cast<double>(s.untangle.corner_evaluations + s.optimize.corner_evaluations);
       std::printf("| %d | %d | %d (%d) | %.3f (%d<=0) | %d/%d/%d/%d | %.2f s (%.2f s) | %.3f (%d<=0) | "
-                  "%d/%d/%.2f s | %.3f (%d<=0) | %.2f s | %.3g |\n",
+                  "%d/%d/%.2f s | %.3f (%d<=0) | %.4f | %.2f s | %.3g |\n",
                   m.num_hexes(), s.free_vertices, s.forced_corners, s.forced_nonpositive,
                   s.untangle.min_sj_before, s.untangle.nonpositive_before, s.untangle.rounds,
                   s.untangle.iterations, s.untangle.evaluations, s.untangle.factorizations,
                   s.untangle.time_s, s.untangle.solve_time_s, s.untangle.min_sj_after,
                   s.untangle.nonpositive_after, s.optimize.rounds, s.optimize.evaluations,
-                  s.optimize.time_s, s.optimize.min_sj_after, s.optimize.nonpositive_after, s.time_s,
+                  s.optimize.time_s, s.optimize.min_sj_after, s.optimize.nonpositive_after,
+                  run_quality(u.mesh).sj_mean, s.time_s,
                   corner_evals / std::max(1e-9, s.time_s));
       std::fflush(stdout);
     }

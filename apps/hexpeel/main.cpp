@@ -7,7 +7,8 @@
 //                [--method original|kremer] [--no-zero-volume] [--no-enclosed] [--no-concave]
 //                [--no-false-positive] [--no-concave-waits] [--strict-intrusion]
 //                [--pillow auto|all|none] [--no-untangle] [--no-optimize]
-//                [--polish-iterations N] [--quality-passes N] [--no-mean-sweep]
+//                [--polish-iterations N] [--quality-passes N] [--final-polish-runs N]
+//                [--no-mean-sweep]
 //                [--solver lbfgs|newton] [--alternatives N]
 //                [--alternatives-always] [--threads N] [--quiet]
 //   hexpeel quality MESH [--surface IN] [--json FILE] [--threads N]
@@ -325,8 +326,9 @@ int main(int argc, char** argv) {
   mesh->add_flag("--no-optimize", no_optimize,
                  "skip the scaled-Jacobian optimization after untangling (default: optimize)");
   mesh->add_option("--polish-iterations", params.untangle.max_mean_inner,
-                   "L-BFGS iterations of the mean polish near the end of the optimization (raises the "
-                   "mean scaled Jacobian and never lowers the minimum; 0 = skip it, for speed)")
+                   "L-BFGS iterations of the mean polish in each optimization pass and of each run "
+                   "of the final polish (raises the mean scaled Jacobian and never lowers the "
+                   "minimum; 0 = skip both, for speed)")
       ->check(CLI::Range(0, 100000))->capture_default_str();
   mesh->add_option("--quality-passes", params.untangle.quality_passes,
                    "passes of the optimization (restarts, mean polish, max-min sweeps), each from "
@@ -334,6 +336,12 @@ int main(int argc, char** argv) {
                    "a pass that lowers the minimum, or the mean by more than it raises the minimum, "
                    "is undone (1 = one pass, faster)")
       ->check(CLI::Range(1, 100))->capture_default_str();
+  mesh->add_option("--final-polish-runs", params.untangle.final_polish_runs,
+                   "L-BFGS runs of the final mean polish after the passes (a log barrier keeps "
+                   "every term above the minimum the passes reached, so it never lowers it), "
+                   "before the mean sweeps (so not with --no-mean-sweep); a further run only when "
+                   "the last did not converge; 0 = skip it, for speed")
+      ->check(CLI::Range(0, 100))->capture_default_str();
   bool no_mean_sweep = false;
   mesh->add_flag("--no-mean-sweep", no_mean_sweep,
                  "skip the local sweeps over every interior vertex that end the optimization "

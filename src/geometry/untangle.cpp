@@ -1101,11 +1101,13 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
     // Mean polish: the restarts' objective plus a flat exponential that weighs every corner
     // nearly alike. The hexes within mean_pin of the minimum keep all 8 vertices where they are,
     // every other corner must stay above the minimum, and the polish is undone if the minimum
-    // still ends lower.
-    auto run_polish = [&] {
-      if (params.max_mean_inner <= 0 || !(params.mean_weight > 0.0) || !(params.mean_pin > 0.0) ||
-          !(smin > 0.0))
-        return;
+    // still ends lower. `barrier` adds the kernel's log barrier at that floor; up to `runs`
+    // L-BFGS runs while one ends unconverged. Sets `kept` when the result stays; returns the
+    // runs made.
+    auto run_polish = [&](double barrier, int runs, bool& kept) {
+      if (runs <= 0 || params.max_mean_inner <= 0 || !(params.mean_weight > 0.0) ||
+          !(params.mean_pin > 0.0) || !(smin > 0.0))
+        return 0;
       const Eigen::VectorXd x_min = x;
       const double s_now = prob.min_corner_value();  // at x (a last restart may have lost a bit)
       prob.hex_min_value(hex_s);
@@ -1119,16 +1121,29 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
       km.floor = s_now;  // the hexes it evaluates start at >= s_now + mean_pin (the rest pinned)
       km.mean_beta = params.mean_beta;
       km.mean_weight = params.mean_weight;
-      const int32_t ns = minimize_region(prob, sub, sub_fixed, km, x, params,
-                                         params.max_mean_inner, params.inner_delta,
-                                         res.stats.optimize);
-      prob.evaluate(x, g, k);
-      if (ns > 0 && prob.min_corner_value() >= s_now) {
-        res.stats.mean_polish_kept = true;
-      } else {
+      km.barrier = barrier;
+      int32_t ns = 0;
+      int made = 0;
+      while (made < runs) {
+        const int32_t iterations_before = res.stats.optimize.iterations;
+        const Eigen::VectorXd x_run = x;
+        ns = minimize_region(prob, sub, sub_fixed, km, x, params, params.max_mean_inner,
+                             params.inner_delta, res.stats.optimize);
+        const int32_t iterations = res.stats.optimize.iterations - iterations_before;
+        ++made;
+        prob.evaluate(x, g, k);  // also the positions the next run's region starts from
+        if (runs > 1) ctx.report("polish", static_cast<double>(made) / runs);
+        // Converged (the delta or gradient test), or stuck where it started: done. Out of
+        // iterations, or a line search failure after some progress (0 iterations counted):
+        // another run, with a fresh L-BFGS memory.
+        if ((iterations > 0 && iterations < params.max_mean_inner) || x == x_run) break;
+      }
+      kept = ns > 0 && prob.min_corner_value() >= s_now;
+      if (!kept) {
         x = x_min;
         prob.evaluate(x, g, k);
       }
+      return made;
     };
     // Passes: restarts, mean polish, max-min sweeps. A later pass starts the restarts from where
     // the sweeps left the points; it is undone if it ends with a lower minimum, or lowers the
@@ -1146,7 +1161,9 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
         kept_pass = res.stats.mean_polish_kept, moves_pass = res.stats.local_moves;
       }
       run_restarts(pass, passes);
-      run_polish();
+      bool polish_kept = false;
+      run_polish(0.0, 1, polish_kept);
+      res.stats.mean_polish_kept |= polish_kept;
       if (sweeps) run_sweeps(true, false);
       prob.evaluate(x, g, k);
       const double s_end = prob.min_corner_value();
@@ -1161,7 +1178,27 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
       smin = s_end;
       if (s_end - s_pass < params.quality_pass_gain) break;
     }
-    if (sweeps) run_sweeps(false, true);
+    // The final polish only prepares the mean sweeps (see final_polish_runs). When the mean
+    // sweeps from its point end below the mean the passes left, they run again from there.
+    const bool mean_sweeps = sweeps && params.local_all && params.local_polish_stop > 0.0;
+    if (mean_sweeps) {
+      const Eigen::VectorXd x_passes = x;
+      const double mean_passes = mean_hex_value();
+      const int64_t moves_passes = res.stats.local_moves;
+      res.stats.final_polish_runs =
+          run_polish(params.final_polish_barrier, params.final_polish_runs,
+                     res.stats.final_polish_kept);
+      run_sweeps(false, true);
+      if (res.stats.final_polish_kept) {
+        prob.evaluate(x, g, k);
+        if (mean_hex_value() < mean_passes) {
+          x = x_passes;
+          res.stats.local_moves = moves_passes;
+          res.stats.final_polish_kept = false;
+          run_sweeps(false, true);
+        }
+      }
+    }
     res.stats.optimize.evaluations += prob.evaluations - ev0;
     res.stats.optimize.corner_evaluations += prob.corner_evaluations - cev0;
     HexMesh before = res.mesh;
@@ -1171,6 +1208,7 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
       res.mesh = std::move(before);
       res.stats.optimize_reverted = true;
       res.stats.mean_polish_kept = false;
+      res.stats.final_polish_kept = false;
     } else {
       res.stats.optimize.min_sj_after = q2.min;
       res.stats.optimize.nonpositive_after = q2.nonpositive;

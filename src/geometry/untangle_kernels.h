@@ -258,6 +258,14 @@ struct QualityKernel {
   /// small mean_beta every corner weighs nearly alike, which keeps the typical corner up while
   /// beta's term lifts the worst (0 = off).
   double mean_beta = 0.0, mean_weight = 0.0;
+  /// A log barrier: + barrier (-log(s - floor)) per term (0 = off; needs a finite floor). The
+  /// floor alone is a wall the energy does not see coming: L-BFGS steps keep hitting it and the
+  /// line search cuts them to almost nothing; the barrier's gradient turns them away first.
+  double barrier = 0.0;
+  /// The barrier's value and its derivative in s, added to f and k (df/ds).
+  void add_barrier(double s, double& f, double& k) const {
+    if (barrier > 0.0) f -= barrier * std::log(s - floor), k -= barrier / (s - floor);
+  }
   double operator()(const Vec3& e0, const Vec3& e1, const Vec3& e2, Vec3& g0, Vec3& g1, Vec3& g2,
                     double& s) const {
     const Vec3 d0 = e1.cross(e2), d1 = e2.cross(e0), d2 = e0.cross(e1);
@@ -279,8 +287,9 @@ struct QualityKernel {
     }
     const double f1 = std::exp(beta * (s_ref - s));
     const double f2 = mean_weight != 0.0 ? mean_weight * std::exp(mean_beta * (s_ref - s)) : 0.0;
-    const double f = f1 + f2;
-    const double k = -beta * f1 - mean_beta * f2;  // df/ds
+    double f = f1 + f2;
+    double k = -beta * f1 - mean_beta * f2;  // df/ds
+    add_barrier(s, f, k);
     const double kl = k * inv_l, ks = k * s * inv_pr;
     Vec3 w0, w1, w2;
     double wdet;
@@ -325,7 +334,8 @@ struct QualityKernel {
       const double fw = winslow.finish(a2[i] + b2[i] + c2[i], hc.det[i], inv_c[i], inv_r[i], c23[i],
                                        k2, kd);
       f += ex[i] + ex2[i] + mu * fw;
-      const double k = -beta * ex[i] - mean_beta * ex2[i];  // df/ds
+      double k = -beta * ex[i] - mean_beta * ex2[i];  // df/ds
+      add_barrier(s[i], f, k);
       const double kl = k * inv_l[i], ks = k * s[i] * inv_pr[i];
       hc.scatter(i, mu * k2 - ks * b2[i] * c2[i], mu * k2 - ks * a2[i] * c2[i],
                  mu * k2 - ks * a2[i] * b2[i], kl + mu * kd, g);

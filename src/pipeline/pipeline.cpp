@@ -388,6 +388,8 @@ nlohmann::json to_json(const MeshResult& r) {
                      {"mean_polish_kept", u.mean_polish_kept},
                      {"local_moves", u.local_moves},
                      {"quality_passes", u.quality_passes},
+                     {"final_polish_runs", u.final_polish_runs},
+                     {"final_polish_kept", u.final_polish_kept},
                      {"time_s", u.time_s}};
   }
   j["timings_s"] = {{"check", r.timings.check_s},
