@@ -177,21 +177,29 @@ struct UntangleParams {
   /// a fresh L-BFGS memory) only when the last ran out of iterations, or its line search failed
   /// after moving the points; 0 runs skip it.
   /// It runs only when the mean sweeps follow: on its own it can lower that mean (its energy
-  /// weighs every term, not each hex's worst: a pillowed voxel solid 0.7263 -> 0.7147), and the
-  /// mean sweeps climb higher from its point than from the passes' (there 0.7282 -> 0.7368).
-  /// When they end below the mean the passes left (a jittered sphere: 0.76122 against 0.76134),
-  /// the polish is dropped and the mean sweeps run again from the passes' point. That guard
+  /// weighs every term, not each hex's worst: a pillowed voxel solid 0.7263 -> 0.7147 with
+  /// regularization 0.01), and the mean sweeps climb higher from its point than from the
+  /// passes' (there 0.7282 -> 0.7393). When they end below the mean the passes left (a 4x4
+  /// cubed sphere: 0.9254 against 0.9274 in the mean of the hexes' worst active terms), the
+  /// polish is dropped and the mean sweeps run again from the passes' point. That guard
   /// compares with the passes' mean before any mean sweep, not with what the mean sweeps alone
-  /// would reach, so the mean can still end a little below the run without the polish (the 4
-  /// surfaces above).
-  /// On 77 generated and CAD-like surfaces: mean higher on 19 (gear 0.828 -> 0.892, gear_fine
-  /// 0.856 -> 0.892, vase 0.964 -> 0.976), lower on 4 by at most 0.0003 (cubed spheres);
-  /// minimum the same on 74, higher on 2, lower on 1 by 0.0001 (the mean sweeps' own effect on
-  /// it). pierrot 0.7911 -> 0.7972, screw2 0.5751 -> 0.5864, the same minima. The passes' own
+  /// would reach, so the mean can still end a little below the run without the polish (4 of the
+  /// 77, by at most 0.0003, with regularization 0.01 in the polish; none with 0.002).
+  /// On 77 generated and CAD-like surfaces (with final_polish_regularization 0.002): mean higher
+  /// on 24 (gear 0.828 -> 0.903, gear_fine 0.856 -> 0.903, vase 0.964 -> 0.977), lower on none;
+  /// minimum the same on 75, higher on 2 (the mean sweeps' own effect on it: disk 0.6152 ->
+  /// 0.6159). pierrot 0.7911 -> 0.7989, screw2 0.5751 -> 0.6059, the same minima. The passes' own
   /// polish has no barrier: with one (0.01) the sweeps after it reached a lower minimum on 12 of
   /// 77 and a higher one on 7, and vase's mean fell 0.964 -> 0.956.
   int final_polish_runs = 3;
   double final_polish_barrier = 3e-3;  ///< > 0; <= 0 (or NaN) leaves the floor alone
+  /// The final polish's weight of the Winslow regularizer (the passes use regularization). 0.002
+  /// rather than 0.01: on 77 surfaces mean higher on 16 (gear 0.892 -> 0.903, gear_fine 0.892 ->
+  /// 0.903, cylinder 0.941 -> 0.945), lower on 8 by at most 0.0004, the minimum the same on 74
+  /// (higher on 2, lower on 1: gear_fine 0.3186 -> 0.3178, the mean sweeps' own effect);
+  /// pierrot 0.7972 -> 0.7989, screw2 0.5864 -> 0.6059. 0.001 and 0.003 did about as well on
+  /// three of them, 0.0003 and 0 worse (gear 0.868, 0.831).
+  double final_polish_regularization = 2e-3;
   /// Phase 2 restarts (re-centred on the new minimum), 0..1000; they also stop once a restart
   /// raises the minimum corner s by less than 1e-3. 6 (was 4): with focus_width the restarts are
   /// cheap, and csphere_n12 still gained 0.005 in its 4th. 8 since restart_delta 1e-5 made each

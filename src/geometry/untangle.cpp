@@ -1101,10 +1101,10 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
     // Mean polish: the restarts' objective plus a flat exponential that weighs every corner
     // nearly alike. The hexes within mean_pin of the minimum keep all 8 vertices where they are,
     // every other corner must stay above the minimum, and the polish is undone if the minimum
-    // still ends lower. `barrier` adds the kernel's log barrier at that floor; up to `runs`
-    // L-BFGS runs while one ends unconverged. Sets `kept` when the result stays; returns the
-    // runs made.
-    auto run_polish = [&](double barrier, int runs, bool& kept) {
+    // still ends lower. `barrier` adds the kernel's log barrier at that floor, `mu` weighs the
+    // Winslow regularizer; up to `runs` L-BFGS runs while one ends unconverged. Sets `kept` when
+    // the result stays; returns the runs made.
+    auto run_polish = [&](double barrier, double mu, int runs, bool& kept) {
       if (runs <= 0 || params.max_mean_inner <= 0 || !(params.mean_weight > 0.0) ||
           !(params.mean_pin > 0.0) || !(smin > 0.0))
         return 0;
@@ -1122,6 +1122,7 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
       km.mean_beta = params.mean_beta;
       km.mean_weight = params.mean_weight;
       km.barrier = barrier;
+      km.mu = mu;
       int32_t ns = 0;
       int made = 0;
       while (made < runs) {
@@ -1162,7 +1163,7 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
       }
       run_restarts(pass, passes);
       bool polish_kept = false;
-      run_polish(0.0, 1, polish_kept);
+      run_polish(0.0, k.mu, 1, polish_kept);
       res.stats.mean_polish_kept |= polish_kept;
       if (sweeps) run_sweeps(true, false);
       prob.evaluate(x, g, k);
@@ -1186,8 +1187,8 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
       const double mean_passes = mean_hex_value();
       const int64_t moves_passes = res.stats.local_moves;
       res.stats.final_polish_runs =
-          run_polish(params.final_polish_barrier, params.final_polish_runs,
-                     res.stats.final_polish_kept);
+          run_polish(params.final_polish_barrier, params.final_polish_regularization,
+                     params.final_polish_runs, res.stats.final_polish_kept);
       run_sweeps(false, true);
       if (res.stats.final_polish_kept) {
         prob.evaluate(x, g, k);

@@ -426,7 +426,7 @@ TEST_F(Cli, QualityPassesOption) {
 }
 
 // --final-polish-runs: the report counts the runs and whether the polish stayed; 0 skips it and
-// gives a lower mean on this solid (0.7368 -> 0.7282); the count is range-checked.
+// gives a lower mean on this solid (0.7393 -> 0.7282); the count is range-checked.
 TEST_F(Cli, FinalPolishRunsOption) {
   const std::string in =
       write("rvox.obj", gen::pillowed(gen::random_voxel_solid(10, 4, 12, 2), 10, 0.3).surface);
