@@ -125,7 +125,10 @@ struct UntangleParams {
   /// (screw2 0.518 -> 0.547); the min fell on one (by 0.001), the mean on one (rvox_s7, by 0.03,
   /// whose min rose 0.31 -> 0.47); the untangling stage took about 3x as long. 0.003 raised the
   /// min a little more but lowered the mean on 6 (star5 by 0.03); 0.1 kept for the mean polish
-  /// alone lowered the mean on 32.
+  /// alone lowered the mean on 32. With the final polish (final_polish_regularization), 0.003
+  /// still trades: screw2 0.031 / 0.606 -> 0.049 / 0.602, pierrot 0.339 / 0.799 -> 0.362 /
+  /// 0.784; on 77 surfaces min higher on 15, lower on 9, mean higher on 19, lower on 11
+  /// (`--regularization`).
   double regularization = 0.01;
   /// Phase 2 then runs local max-min sweeps: the free vertices of the local_hexes worst hexes,
   /// worst first, each moved by a pattern search whose steps never lower the minimum of its hexes
