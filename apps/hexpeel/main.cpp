@@ -8,7 +8,7 @@
 //                [--no-false-positive] [--no-concave-waits] [--strict-intrusion]
 //                [--pillow auto|all|none] [--no-untangle] [--no-optimize]
 //                [--polish-iterations N] [--quality-passes N] [--regularization W]
-//                [--final-polish-runs N]
+//                [--final-polish-runs N] [--final-polish-rounds N]
 //                [--no-mean-sweep]
 //                [--solver lbfgs|newton] [--alternatives N]
 //                [--alternatives-always] [--threads N] [--quiet]
@@ -349,6 +349,11 @@ int main(int argc, char** argv) {
                    "before the mean sweeps (so not with --no-mean-sweep); a further run only when "
                    "the last did not converge; 0 = skip it, for speed")
       ->check(CLI::Range(0, 100))->capture_default_str();
+  mesh->add_option("--final-polish-rounds", params.untangle.final_polish_rounds,
+                   "rounds of final polish and mean sweeps, each from where the last left off and "
+                   "kept only if it raises the mean scaled Jacobian (3: screw2's mean 0.606 -> "
+                   "0.620, 32% more time on 77 test surfaces)")
+      ->check(CLI::Range(1, 100))->capture_default_str();
   bool no_mean_sweep = false;
   mesh->add_flag("--no-mean-sweep", no_mean_sweep,
                  "skip the local sweeps over every interior vertex that end the optimization "

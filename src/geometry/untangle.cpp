@@ -1199,6 +1199,28 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
           run_sweeps(false, true);
         }
       }
+      // Further rounds of polish and mean sweeps, each from where the last left the points,
+      // kept while one raises the mean.
+      for (int round = 1; round < params.final_polish_rounds && res.stats.final_polish_kept;
+           ++round) {
+        prob.evaluate(x, g, k);
+        const Eigen::VectorXd x_round = x;
+        const double mean_round = mean_hex_value();
+        const int64_t moves_round = res.stats.local_moves;
+        bool kept = false;
+        res.stats.final_polish_runs +=
+            run_polish(params.final_polish_barrier, params.final_polish_regularization,
+                       params.final_polish_runs, kept);
+        if (!kept) break;
+        run_sweeps(false, true);
+        prob.evaluate(x, g, k);
+        if (!(mean_hex_value() > mean_round)) {
+          x = x_round;
+          res.stats.local_moves = moves_round;
+          break;
+        }
+        ++res.stats.final_polish_rounds;
+      }
     }
     res.stats.optimize.evaluations += prob.evaluations - ev0;
     res.stats.optimize.corner_evaluations += prob.corner_evaluations - cev0;
@@ -1210,6 +1232,7 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
       res.stats.optimize_reverted = true;
       res.stats.mean_polish_kept = false;
       res.stats.final_polish_kept = false;
+      res.stats.final_polish_rounds = 0;
     } else {
       res.stats.optimize.min_sj_after = q2.min;
       res.stats.optimize.nonpositive_after = q2.nonpositive;

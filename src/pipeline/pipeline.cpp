@@ -390,6 +390,7 @@ nlohmann::json to_json(const MeshResult& r) {
                      {"quality_passes", u.quality_passes},
                      {"final_polish_runs", u.final_polish_runs},
                      {"final_polish_kept", u.final_polish_kept},
+                     {"final_polish_rounds", u.final_polish_rounds},
                      {"time_s", u.time_s}};
   }
   j["timings_s"] = {{"check", r.timings.check_s},
