@@ -1150,17 +1150,21 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
     // the sweeps left the points; it is undone if it ends with a lower minimum, or lowers the
     // mean more than it raises the minimum (weighed as the sweeps weigh them, local_mean_weight),
     // and the passes stop once one raises the minimum by less than quality_pass_gain.
+    // A point to come back to: x, the mean hex value there (prob.pos must hold x) and the
+    // sweeps' move count, which an undo restores with it.
+    struct Checkpoint {
+      Eigen::VectorXd x;
+      double mean = 0.0;
+      int64_t moves = 0;
+    };
+    auto checkpoint = [&] { return Checkpoint{x, mean_hex_value(), res.stats.local_moves}; };
+    auto restore = [&](const Checkpoint& c) { x = c.x, res.stats.local_moves = c.moves; };
     const int passes = std::max(1, params.quality_passes);
-    Eigen::VectorXd x_pass;
-    double mean_pass = 0.0;
-    bool kept_pass = false;    // mean_polish_kept and local_moves at the pass's start, for an undo
-    int64_t moves_pass = 0;
+    Checkpoint at_pass;
+    bool kept_pass = false;  // mean_polish_kept at the pass's start, for an undo
     for (int pass = 0; pass < passes; ++pass) {
       const double s_pass = smin;
-      if (pass > 0) {
-        x_pass = x, mean_pass = mean_hex_value();
-        kept_pass = res.stats.mean_polish_kept, moves_pass = res.stats.local_moves;
-      }
+      if (pass > 0) at_pass = checkpoint(), kept_pass = res.stats.mean_polish_kept;
       run_restarts(pass, passes);
       bool polish_kept = false;
       run_polish(0.0, k.mu, 1, polish_kept);
@@ -1170,10 +1174,10 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
       const double s_end = prob.min_corner_value();
       ++res.stats.quality_passes;
       if (pass > 0 && (s_end < s_pass || (s_end - s_pass) + params.local_mean_weight *
-                                                (mean_hex_value() - mean_pass) < 0.0)) {
-        x = x_pass;
+                                                (mean_hex_value() - at_pass.mean) < 0.0)) {
+        restore(at_pass);
         prob.evaluate(x, g, k);
-        res.stats.mean_polish_kept = kept_pass, res.stats.local_moves = moves_pass;
+        res.stats.mean_polish_kept = kept_pass;
         break;
       }
       smin = s_end;
@@ -1183,18 +1187,17 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
     // sweeps from its point end below the mean the passes left, they run again from there.
     const bool mean_sweeps = sweeps && params.local_all && params.local_polish_stop > 0.0;
     if (mean_sweeps) {
-      const Eigen::VectorXd x_passes = x;
-      const double mean_passes = mean_hex_value();
-      const int64_t moves_passes = res.stats.local_moves;
-      res.stats.final_polish_runs =
-          run_polish(params.final_polish_barrier, params.final_polish_regularization,
-                     params.final_polish_runs, res.stats.final_polish_kept);
+      auto final_polish = [&](bool& kept) {
+        return run_polish(params.final_polish_barrier, params.final_polish_regularization,
+                          params.final_polish_runs, kept);
+      };
+      const Checkpoint at_passes = checkpoint();
+      res.stats.final_polish_runs = final_polish(res.stats.final_polish_kept);
       run_sweeps(false, true);
       if (res.stats.final_polish_kept) {
         prob.evaluate(x, g, k);
-        if (mean_hex_value() < mean_passes) {
-          x = x_passes;
-          res.stats.local_moves = moves_passes;
+        if (mean_hex_value() < at_passes.mean) {
+          restore(at_passes);
           res.stats.final_polish_kept = false;
           run_sweeps(false, true);
         }
@@ -1204,19 +1207,14 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
       for (int round = 1; round < params.final_polish_rounds && res.stats.final_polish_kept;
            ++round) {
         prob.evaluate(x, g, k);
-        const Eigen::VectorXd x_round = x;
-        const double mean_round = mean_hex_value();
-        const int64_t moves_round = res.stats.local_moves;
+        const Checkpoint at_round = checkpoint();
         bool kept = false;
-        res.stats.final_polish_runs +=
-            run_polish(params.final_polish_barrier, params.final_polish_regularization,
-                       params.final_polish_runs, kept);
+        res.stats.final_polish_runs += final_polish(kept);
         if (!kept) break;
         run_sweeps(false, true);
         prob.evaluate(x, g, k);
-        if (!(mean_hex_value() > mean_round)) {
-          x = x_round;
-          res.stats.local_moves = moves_round;
+        if (!(mean_hex_value() > at_round.mean)) {
+          restore(at_round);
           break;
         }
         ++res.stats.final_polish_rounds;
