@@ -238,13 +238,16 @@ struct Problem {
       for (int32_t h = r.begin(); h != r.end(); ++h) {
         Vec3 p[8];
         for (int k = 0; k < 8; ++k) p[k] = pos[hexes[h][k]];
-        untangle_detail::HexCorners hc;
-        hc.load(p, hex_mask[h]);
+        using untangle_detail::kLanes;
+        untangle_detail::HexTerms t;
+        t.load(p);
+        double a2[kLanes], b2[kLanes], c2[kLanes];
+        t.squared_norms(0, a2), t.squared_norms(1, b2), t.squared_norms(2, c2);
         double m = std::numeric_limits<double>::infinity();
-        for (int i = 0; i < hc.n; ++i) {
-          const double l = std::sqrt(hc.e[i][0].squaredNorm() * hc.e[i][1].squaredNorm() *
-                                     hc.e[i][2].squaredNorm());
-          m = std::min(m, l > 1e-300 ? hc.det[i] / l : -1.0);
+        for (int i = 0; i < untangle_detail::kHexTerms; ++i) {
+          if (!(hex_mask[h] >> i & 1u)) continue;
+          const double l = std::sqrt(a2[i] * b2[i] * c2[i]);
+          m = std::min(m, l > 1e-300 ? t.det[i] / l : -1.0);
         }
         out[h] = m;
       }

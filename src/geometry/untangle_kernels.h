@@ -59,49 +59,81 @@ inline constexpr int kCentre = 8;
 /// Entries per hex: the 8 corner tetrahedra and the centre.
 inline constexpr int kHexTerms = 9;
 
-/// The active terms of one hex, gathered for the batched kernels: edge vectors e_k, the
-/// cofactors d_k = d det / d e_k and det, compacted to n entries. Terms 0..7 are the corner
-/// tetrahedra; term 8 (kCentre) is the Jacobian at the centre, the one Verdict's scaled Jacobian
-/// adds to the 8 corners: e_k = a quarter of principal axis k (the sum of the 4 hex edges in
-/// direction k), so a unit cube gives e_k = unit vectors as at its corners. Without it a hex can
-/// have 8 positive corners and still be inverted as a whole (measured on screw2: 144 such hexes).
-struct HexCorners {
-  int n = 0;
-  int corner[kHexTerms];  ///< term index (corner 0..7 or kCentre) of entry i
-  Vec3 e[kHexTerms][3], d[kHexTerms][3];
-  double det[kHexTerms];
-  void load(const Vec3 (&p)[8], unsigned mask) {
-    n = 0;
+/// Lanes of the structure-of-arrays layout: the 9 terms padded to an even count, so that every
+/// loop over them compiles to whole SSE2 pairs.
+inline constexpr int kLanes = 10;
+
+/// The 9 terms of one hex for the batched kernels, in structure-of-arrays form (lane i = term
+/// i): edge vectors e_k, the cofactors d_k = d det / d e_k and det, component by component, so
+/// that the per-term arithmetic runs in SIMD lanes (untangle.cpp is compiled without errno and
+/// trap semantics, which lets GCC vectorize the sqrt and the selects; neither changes a value).
+/// Terms 0..7 are the corner tetrahedra; term 8 (kCentre) is the Jacobian at the centre, the one
+/// Verdict's scaled Jacobian adds to the 8 corners: e_k = a quarter of principal axis k (the sum
+/// of the 4 hex edges in direction k), so a unit cube gives e_k = unit vectors as at its corners.
+/// Without it a hex can have 8 positive corners and still be inverted as a whole (measured on
+/// screw2: 144 such hexes). Every term is computed whatever the mask (the padding lane is a unit
+/// cube); a kernel reads only the active terms' results. Each lane's arithmetic is that of the
+/// one-corner operator(): the same operations in the same order (Eigen's cross, dot and
+/// squaredNorm written out), so the values are the same bit for bit.
+struct HexTerms {
+  alignas(16) double e[3][3][kLanes];  ///< e[k][a][i]: component a of edge vector k of term i
+  alignas(16) double d[3][3][kLanes];  ///< d[k][a][i]: component a of d det / d e_k
+  alignas(16) double det[kLanes];
+  void load(const Vec3 (&p)[8]) {
     for (int c = 0; c < 8; ++c) {
-      if (!(mask >> c & 1u)) continue;
       const auto& fr = kHexCornerFrames[c];
-      Vec3* ei = e[n];
-      ei[0] = p[fr[0]] - p[c], ei[1] = p[fr[1]] - p[c], ei[2] = p[fr[2]] - p[c];
-      set_cofactors(n);
-      corner[n++] = c;
+      for (int k = 0; k < 3; ++k)
+        for (int a = 0; a < 3; ++a) e[k][a][c] = p[fr[k]][a] - p[c][a];
+    }
+    for (int a = 0; a < 3; ++a) {
+      e[0][a][kCentre] = 0.25 * ((((p[1][a] - p[0][a]) + (p[2][a] - p[3][a])) + (p[5][a] - p[4][a])) + (p[6][a] - p[7][a]));
+      e[1][a][kCentre] = 0.25 * ((((p[3][a] - p[0][a]) + (p[2][a] - p[1][a])) + (p[7][a] - p[4][a])) + (p[6][a] - p[5][a]));
+      e[2][a][kCentre] = 0.25 * ((((p[4][a] - p[0][a]) + (p[5][a] - p[1][a])) + (p[6][a] - p[2][a])) + (p[7][a] - p[3][a]));
+    }
+    for (int k = 0; k < 3; ++k)
+      for (int a = 0; a < 3; ++a)
+        for (int i = kHexTerms; i < kLanes; ++i) e[k][a][i] = k == a ? 1.0 : 0.0;  // padding: a unit cube
+    for (int k = 0; k < 3; ++k) {
+      const int k1 = (k + 1) % 3, k2 = (k + 2) % 3;  // d_k = e_k1 x e_k2
+      for (int i = 0; i < kLanes; ++i) {
+        d[k][0][i] = e[k1][1][i] * e[k2][2][i] - e[k1][2][i] * e[k2][1][i];
+        d[k][1][i] = e[k1][2][i] * e[k2][0][i] - e[k1][0][i] * e[k2][2][i];
+        d[k][2][i] = e[k1][0][i] * e[k2][1][i] - e[k1][1][i] * e[k2][0][i];
+      }
+    }
+    for (int i = 0; i < kLanes; ++i)
+      det[i] = (e[0][0][i] * d[0][0][i] + e[0][1][i] * d[0][1][i]) + e[0][2][i] * d[0][2][i];
+  }
+  /// |e_k|^2 per lane into out.
+  void squared_norms(int k, double (&out)[kLanes]) const {
+    for (int i = 0; i < kLanes; ++i)
+      out[i] = (e[k][0][i] * e[k][0][i] + e[k][1][i] * e[k][1][i]) + e[k][2][i] * e[k][2][i];
+  }
+  /// Adds the gradients a_k e_k + b d_k of the terms of `mask` (k = 0, 1, 2) to their points:
+  /// the products lane-parallel, then the sums into g term after term in lane order.
+  void scatter(unsigned mask, const double (&a0)[kLanes], const double (&a1)[kLanes],
+               const double (&a2)[kLanes], const double (&b)[kLanes], Vec3 (&g)[8]) const {
+    alignas(16) double gk[3][3][kLanes];
+    const double(*ak[3])[kLanes] = {&a0, &a1, &a2};
+    for (int k = 0; k < 3; ++k)
+      for (int a = 0; a < 3; ++a)
+        for (int i = 0; i < kLanes; ++i) gk[k][a][i] = (*ak[k])[i] * e[k][a][i] + b[i] * d[k][a][i];
+    for (int i = 0; i < 8; ++i) {
+      if (!(mask >> i & 1u)) continue;
+      const Vec3 g0(gk[0][0][i], gk[0][1][i], gk[0][2][i]), g1(gk[1][0][i], gk[1][1][i], gk[1][2][i]),
+          g2(gk[2][0][i], gk[2][1][i], gk[2][2][i]);
+      const auto& fr = kHexCornerFrames[i];
+      g[fr[0]] += g0;
+      g[fr[1]] += g1;
+      g[fr[2]] += g2;
+      g[i] -= g0 + g1 + g2;
     }
     if (mask >> kCentre & 1u) {
-      Vec3* ei = e[n];
-      ei[0] = 0.25 * ((p[1] - p[0]) + (p[2] - p[3]) + (p[5] - p[4]) + (p[6] - p[7]));
-      ei[1] = 0.25 * ((p[3] - p[0]) + (p[2] - p[1]) + (p[7] - p[4]) + (p[6] - p[5]));
-      ei[2] = 0.25 * ((p[4] - p[0]) + (p[5] - p[1]) + (p[6] - p[2]) + (p[7] - p[3]));
-      set_cofactors(n);
-      corner[n++] = kCentre;
-    }
-  }
-  void set_cofactors(int i) {
-    d[i][0] = e[i][1].cross(e[i][2]), d[i][1] = e[i][2].cross(e[i][0]), d[i][2] = e[i][0].cross(e[i][1]);
-    det[i] = e[i][0].dot(d[i][0]);
-  }
-  double tr(int i) const { return e[i][0].squaredNorm() + e[i][1].squaredNorm() + e[i][2].squaredNorm(); }
-  /// Adds the gradient a_k e_k + b d_k of entry i (k = 0, 1, 2) to the term's points.
-  void scatter(int i, double a0, double a1, double a2, double b, Vec3 (&g)[8]) const {
-    const int c = corner[i];
-    const Vec3 g0 = a0 * e[i][0] + b * d[i][0], g1 = a1 * e[i][1] + b * d[i][1],
-               g2 = a2 * e[i][2] + b * d[i][2];
-    if (c == kCentre) {
       // d e_k / d p_j = +-1/4: + for the points on the far side in direction k.
-      const Vec3 q0 = 0.25 * g0, q1 = 0.25 * g1, q2 = 0.25 * g2;
+      const int i = kCentre;
+      const Vec3 q0 = 0.25 * Vec3(gk[0][0][i], gk[0][1][i], gk[0][2][i]),
+                 q1 = 0.25 * Vec3(gk[1][0][i], gk[1][1][i], gk[1][2][i]),
+                 q2 = 0.25 * Vec3(gk[2][0][i], gk[2][1][i], gk[2][2][i]);
       g[0] -= q0 + q1 + q2;
       g[1] += q0 - q1 - q2;
       g[2] += q0 + q1 - q2;
@@ -110,15 +142,28 @@ struct HexCorners {
       g[5] += q0 - q1 + q2;
       g[6] += q0 + q1 + q2;
       g[7] += -q0 + q1 + q2;
-      return;
     }
-    const auto& fr = kHexCornerFrames[c];
-    g[fr[0]] += g0;
-    g[fr[1]] += g1;
-    g[fr[2]] += g2;
-    g[c] -= g0 + g1 + g2;
   }
 };
+
+/// inv_cbrt over all lanes: the bit guesses one by one, the Newton steps lane-parallel.
+inline void inv_cbrt_lanes(const double (&x)[kLanes], double (&y)[kLanes]) {
+  bool outside = false;
+  for (int i = 0; i < kLanes; ++i) {
+    uint64_t b;
+    std::memcpy(&b, &x[i], sizeof b);
+    b = 0x553ef0ff289dd796ULL - b / 3;
+    std::memcpy(&y[i], &b, sizeof b);
+    outside |= !(x[i] > 1e-300 && x[i] < 1e300);
+  }
+  double t[kLanes];
+  for (int i = 0; i < kLanes; ++i) t[i] = x[i] * (1.0 / 3.0);
+  for (int k = 0; k < 4; ++k)
+    for (int i = 0; i < kLanes; ++i) y[i] = y[i] * (4.0 / 3.0) - t[i] * (y[i] * y[i]) * (y[i] * y[i]);
+  if (outside)
+    for (int i = 0; i < kLanes; ++i)
+      if (!(x[i] > 1e-300 && x[i] < 1e300)) y[i] = 1.0 / std::cbrt(x[i]);
+}
 
 /// Phase 1 kernel: the regularized Winslow + volume energy of one corner tetrahedron.
 struct WinslowKernel {
@@ -164,23 +209,39 @@ struct WinslowKernel {
     return fw + lambda * fv;
   }
 
-  /// The sum of f over the corners of one hex whose bit is set in `mask` (points p, local
-  /// numbering), the gradient added per local point into g, the min det into vmin. Same values as
-  /// operator() corner by corner; staged so that the 8 corners' long dependency chains (sqrt,
-  /// division, cube root) are independent and overlap.
-  double hex(const Vec3 (&p)[8], unsigned mask, Vec3 (&g)[8], double& vmin) const {
-    HexCorners hc;
-    hc.load(p, mask);
-    double inv_c[kHexTerms], inv_r[kHexTerms], c23[kHexTerms];
-    for (int i = 0; i < hc.n; ++i) reciprocals(hc.det[i], inv_c[i], inv_r[i]);
-    for (int i = 0; i < hc.n; ++i) c23[i] = inv_c[i] * inv_cbrt(inv_c[i]);
-    double f = 0.0;
-    for (int i = 0; i < hc.n; ++i) {
-      double k2, kd;
-      f += finish(hc.tr(i), hc.det[i], inv_c[i], inv_r[i], c23[i], k2, kd);
-      vmin = std::min(vmin, hc.det[i]);
-      hc.scatter(i, k2, k2, k2, kd, g);
+  /// reciprocals() lane-parallel: both branches computed, the sign of det selects.
+  void reciprocals_lanes(const double (&det)[kLanes], double (&inv_c)[kLanes], double (&inv_r)[kLanes]) const {
+    const double e2 = eps * eps;
+    for (int i = 0; i < kLanes; ++i) {
+      const double r = std::sqrt(e2 + det[i] * det[i]);
+      const double q = 1.0 / (r * (det[i] + r));
+      const double ir_pos = (det[i] + r) * q, ic_pos = 2.0 * r * q;
+      const double ir_neg = 1.0 / r, ic_neg = 2.0 * (r - det[i]) / e2;
+      inv_r[i] = det[i] > 0 ? ir_pos : ir_neg;
+      inv_c[i] = det[i] > 0 ? ic_pos : ic_neg;
     }
+  }
+  /// The sum of f over the terms of one hex whose bit is set in `mask` (points p, local
+  /// numbering; terms in lane order), the gradient added per local point into g, the min det
+  /// into vmin. The same values as operator() term by term, lane-parallel.
+  double hex(const Vec3 (&p)[8], unsigned mask, Vec3 (&g)[8], double& vmin) const {
+    HexTerms t;
+    t.load(p);
+    double inv_c[kLanes], inv_r[kLanes], c23[kLanes], tr[kLanes], n1[kLanes], n2[kLanes];
+    reciprocals_lanes(t.det, inv_c, inv_r);
+    inv_cbrt_lanes(inv_c, c23);
+    for (int i = 0; i < kLanes; ++i) c23[i] *= inv_c[i];
+    t.squared_norms(0, tr), t.squared_norms(1, n1), t.squared_norms(2, n2);
+    for (int i = 0; i < kLanes; ++i) tr[i] = (tr[i] + n1[i]) + n2[i];
+    double fv[kLanes], k2[kLanes], kd[kLanes];
+    for (int i = 0; i < kLanes; ++i) fv[i] = finish(tr[i], t.det[i], inv_c[i], inv_r[i], c23[i], k2[i], kd[i]);
+    double f = 0.0;
+    for (int i = 0; i < kHexTerms; ++i) {
+      if (!(mask >> i & 1u)) continue;
+      f += fv[i];
+      vmin = std::min(vmin, t.det[i]);
+    }
+    t.scatter(mask, k2, k2, k2, kd, g);
     return f;
   }
 
@@ -300,46 +361,69 @@ struct QualityKernel {
     return f + mu * fw;
   }
 
-  /// Batched over the corners of one hex like WinslowKernel::hex; vmin receives the min s. +inf
-  /// (and no gradient) when a corner is degenerate or at or below the floor.
+
+  /// Batched over the terms of one hex like WinslowKernel::hex; vmin receives the min s. +inf
+  /// (and no gradient) when a term is degenerate or at or below the floor.
   double hex(const Vec3 (&p)[8], unsigned mask, Vec3 (&g)[8], double& vmin) const {
-    HexCorners hc;
-    hc.load(p, mask);
-    double a2[kHexTerms], b2[kHexTerms], c2[kHexTerms], inv_pr[kHexTerms], inv_l[kHexTerms], s[kHexTerms];
+    HexTerms t;
+    t.load(p);
+    double a2[kLanes], b2[kLanes], c2[kLanes], l[kLanes], inv_pr[kLanes], inv_l[kLanes], s[kLanes];
+    t.squared_norms(0, a2), t.squared_norms(1, b2), t.squared_norms(2, c2);
+    for (int i = 0; i < kLanes; ++i) {
+      // One division: 1/l = l / (a2 b2 c2) and 1/a2 = b2 c2 / (a2 b2 c2).
+      const double pr = a2[i] * b2[i] * c2[i];
+      l[i] = std::sqrt(pr);
+      inv_pr[i] = 1.0 / pr;
+      inv_l[i] = l[i] * inv_pr[i];
+      s[i] = l[i] > 1e-300 ? t.det[i] * inv_l[i] : -1.0;
+    }
     bool bad = false;
-    for (int i = 0; i < hc.n; ++i) {
-      a2[i] = hc.e[i][0].squaredNorm(), b2[i] = hc.e[i][1].squaredNorm(), c2[i] = hc.e[i][2].squaredNorm();
-      const double pr = a2[i] * b2[i] * c2[i], l = std::sqrt(pr);
-      if (!(l > 1e-300)) {
-        s[i] = -1.0;
-      } else {
-        inv_pr[i] = 1.0 / pr;
-        inv_l[i] = l * inv_pr[i];
-        s[i] = hc.det[i] * inv_l[i];
-      }
+    for (int i = 0; i < kHexTerms; ++i) {
+      if (!(mask >> i & 1u)) continue;
       vmin = std::min(vmin, s[i]);
-      bad |= !(l > 1e-300) || s[i] <= floor;
+      bad |= !(l[i] > 1e-300) || s[i] <= floor;
     }
     if (bad) return std::numeric_limits<double>::infinity();
-    double inv_c[kHexTerms], inv_r[kHexTerms], c23[kHexTerms], ex[kHexTerms];
-    for (int i = 0; i < hc.n; ++i) winslow.reciprocals(hc.det[i], inv_c[i], inv_r[i]);
-    for (int i = 0; i < hc.n; ++i) c23[i] = inv_c[i] * inv_cbrt(inv_c[i]);
-    for (int i = 0; i < hc.n; ++i) ex[i] = std::exp(beta * (s_ref - s[i]));
-    double ex2[kHexTerms];
-    for (int i = 0; i < hc.n; ++i)
-      ex2[i] = mean_weight != 0.0 ? mean_weight * std::exp(mean_beta * (s_ref - s[i])) : 0.0;
-    double f = 0.0;
-    for (int i = 0; i < hc.n; ++i) {
+    double inv_c[kLanes], inv_r[kLanes], c23[kLanes];
+    winslow.reciprocals_lanes(t.det, inv_c, inv_r);
+    inv_cbrt_lanes(inv_c, c23);
+    for (int i = 0; i < kLanes; ++i) c23[i] *= inv_c[i];
+    // The exponentials (library calls) of the active terms only.
+    double ex[kLanes], ex2[kLanes];
+    for (int i = 0; i < kHexTerms; ++i) ex[i] = mask >> i & 1u ? std::exp(beta * (s_ref - s[i])) : 0.0;
+    for (int i = 0; i < kHexTerms; ++i)
+      ex2[i] = mean_weight != 0.0 && (mask >> i & 1u) ? mean_weight * std::exp(mean_beta * (s_ref - s[i])) : 0.0;
+    ex[kHexTerms] = ex2[kHexTerms] = 0.0;
+    // term value; k = df/ds; the Winslow gradient's factors (k2 e_k + kd d_k, times mu)
+    double value[kLanes], k[kLanes], wk2[kLanes], wkd[kLanes];
+    for (int i = 0; i < kLanes; ++i) {
       double k2, kd;
-      const double fw = winslow.finish(a2[i] + b2[i] + c2[i], hc.det[i], inv_c[i], inv_r[i], c23[i],
-                                       k2, kd);
-      f += ex[i] + ex2[i] + mu * fw;
-      double k = -beta * ex[i] - mean_beta * ex2[i];  // df/ds
-      add_barrier(s[i], f, k);
-      const double kl = k * inv_l[i], ks = k * s[i] * inv_pr[i];
-      hc.scatter(i, mu * k2 - ks * b2[i] * c2[i], mu * k2 - ks * a2[i] * c2[i],
-                 mu * k2 - ks * a2[i] * b2[i], kl + mu * kd, g);
+      const double fw = winslow.finish((a2[i] + b2[i]) + c2[i], t.det[i], inv_c[i], inv_r[i], c23[i], k2, kd);
+      value[i] = ex[i] + ex2[i] + mu * fw;
+      k[i] = -beta * ex[i] - mean_beta * ex2[i];
+      wk2[i] = mu * k2, wkd[i] = mu * kd;
     }
+    double barrier_value[kLanes] = {};  // add_barrier, lane-parallel but for the logarithm
+    if (barrier > 0.0) {
+      for (int i = 0; i < kLanes; ++i) k[i] -= barrier / (s[i] - floor);
+      for (int i = 0; i < kHexTerms; ++i)
+        if (mask >> i & 1u) barrier_value[i] = barrier * std::log(s[i] - floor);
+    }
+    double a0[kLanes], a1[kLanes], a2k[kLanes], bk[kLanes];  // gradient a_k e_k + b d_k
+    for (int i = 0; i < kLanes; ++i) {
+      const double kl = k[i] * inv_l[i], ks = k[i] * s[i] * inv_pr[i];
+      a0[i] = wk2[i] - ks * b2[i] * c2[i];
+      a1[i] = wk2[i] - ks * a2[i] * c2[i];
+      a2k[i] = wk2[i] - ks * a2[i] * b2[i];
+      bk[i] = kl + wkd[i];
+    }
+    double f = 0.0;
+    for (int i = 0; i < kHexTerms; ++i) {
+      if (!(mask >> i & 1u)) continue;
+      f += value[i];
+      if (barrier > 0.0) f -= barrier_value[i];
+    }
+    t.scatter(mask, a0, a1, a2k, bk, g);
     return f;
   }
 };

@@ -170,6 +170,35 @@ TEST(GeometryUntangle, HexKernelsMatchCornerKernels) {
   }
 }
 
+// The batched kernels compute all nine terms whatever the mask: a degenerate term whose bit is
+// clear (two coincident points) must neither make the energy infinite nor reach the gradient or
+// the minimum, and the result must not depend on it.
+TEST(GeometryUntangle, HexKernelsIgnoreMaskedOutTerms) {
+  Vec3 p[8] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+  for (int k = 0; k < 8; ++k) p[k] += 0.1 * Vec3(std::sin(k + 1.0), std::cos(2.0 * k), std::sin(3.0 * k));
+  Vec3 q[8];
+  std::copy(p, p + 8, q);
+  q[1] = q[0];  // corners 0 and 1 degenerate (an edge of length 0)
+  // Corners 3, 4, 6, 7 (no centre): the ones whose tetrahedra do not contain point 1.
+  const unsigned mask = 1u << 3 | 1u << 4 | 1u << 6 | 1u << 7;
+  untangle_detail::WinslowKernel w{1e-3, 1.0};
+  untangle_detail::QualityKernel k{30.0, 0.2, 0.0, 0.1, untangle_detail::WinslowKernel{1e-10, 1.0}};
+  k.barrier = 0.003, k.mean_beta = 2.0, k.mean_weight = 1.0;
+  auto check = [&](const auto& kernel) {
+    Vec3 gp[8], gq[8];
+    for (int i = 0; i < 8; ++i) gp[i].setZero(), gq[i].setZero();
+    double mp = std::numeric_limits<double>::infinity(), mq = mp;
+    const double fp = kernel.hex(p, mask, gp, mp);
+    const double fq = kernel.hex(q, mask, gq, mq);
+    ASSERT_TRUE(std::isfinite(fq));
+    EXPECT_EQ(fp, fq);
+    EXPECT_EQ(mp, mq);
+    for (int i = 0; i < 8; ++i) EXPECT_EQ(gp[i], gq[i]) << "point " << i;
+  };
+  check(w);
+  check(k);
+}
+
 // The final polish's log barrier adds exactly -barrier log(s - floor) to a term's energy (its
 // derivative is checked on whole hexes by the gradient test below).
 TEST(GeometryUntangle, BarrierAddsMinusLogOfTheGapToTheFloor) {
