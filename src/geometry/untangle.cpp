@@ -842,8 +842,9 @@ int64_t local_max_min(const Problem& prob, std::vector<Vec3>& pts, const Untangl
   // Searches the vertices of `verts` in their order, as one after the other would, but in
   // parallel where that gives the same result: a search reads and moves only points of its
   // vertex's hexes, so a vertex that shares no hex with an earlier one still to run may run
-  // now. Level l holds the vertices whose latest earlier hex-sharing vertex is at level l - 1;
-  // the levels run in order, the vertices of one in parallel. Returns the moves.
+  // now. A vertex's level is one above the highest level of the earlier vertices it shares a
+  // hex with (0 when there are none), so two of one level share no hex; the levels run in
+  // order, the vertices of one in parallel. Returns the moves.
   std::vector<int32_t> hex_level(nh), level, by_level;
   auto search_in_order = [&](const std::vector<int32_t>& verts, double stop, double w) {
     const size_t n = verts.size();
@@ -854,8 +855,7 @@ int64_t local_max_min(const Problem& prob, std::vector<Vec3>& pts, const Untangl
       for (int32_t i = first(verts[j]); i < last(verts[j]); ++i)
         l = std::max(l, hex_level[prob.inc_slot[i] / 8] + 1);
       level[j] = l;
-      for (int32_t i = first(verts[j]); i < last(verts[j]); ++i)
-        hex_level[prob.inc_slot[i] / 8] = std::max(hex_level[prob.inc_slot[i] / 8], l);
+      for (int32_t i = first(verts[j]); i < last(verts[j]); ++i) hex_level[prob.inc_slot[i] / 8] = l;
     }
     by_level.resize(n);
     std::iota(by_level.begin(), by_level.end(), 0);

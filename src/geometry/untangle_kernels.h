@@ -1,7 +1,7 @@
 // Per-corner energies of the untangler (src/geometry/untangle.cpp), kept in a header so the tests
 // can check gradients and Hessians against finite differences. The untangler evaluates them hex
-// by hex (`hex()`: the same values, staged so the 8 corners' sqrt / division / cube-root chains
-// overlap); operator() is the one-corner reference.
+// by hex (`hex()`: the nine terms of a hex side by side in SIMD lanes, see HexTerms; the same
+// values as operator() up to rounding); operator() is the one-corner reference.
 //
 // A corner tetrahedron is (p_c, p_n0, p_n1, p_n2) with edge vectors e_k = p_nk - p_c, and the
 // Jacobian F = [e0 e1 e2] (in units of the reference edge length). Phase 1's energy
@@ -65,16 +65,20 @@ inline constexpr int kLanes = 10;
 
 /// The 9 terms of one hex for the batched kernels, in structure-of-arrays form (lane i = term
 /// i): edge vectors e_k, the cofactors d_k = d det / d e_k and det, component by component, so
-/// that the per-term arithmetic runs in SIMD lanes (untangle.cpp is compiled without errno and
-/// trap semantics, which lets GCC vectorize the sqrt and the selects; neither changes a value).
+/// that the per-term arithmetic runs in SIMD lanes (the library is compiled without errno and
+/// trap semantics, which lets GCC vectorize the sqrt and the selects; neither changes a value;
+/// the tests that include this header are not, and get the same values unvectorized).
 /// Terms 0..7 are the corner tetrahedra; term 8 (kCentre) is the Jacobian at the centre, the one
 /// Verdict's scaled Jacobian adds to the 8 corners: e_k = a quarter of principal axis k (the sum
 /// of the 4 hex edges in direction k), so a unit cube gives e_k = unit vectors as at its corners.
 /// Without it a hex can have 8 positive corners and still be inverted as a whole (measured on
 /// screw2: 144 such hexes). Every term is computed whatever the mask (the padding lane is a unit
-/// cube); a kernel reads only the active terms' results. Each lane's arithmetic is that of the
-/// one-corner operator(): the same operations in the same order (Eigen's cross, dot and
-/// squaredNorm written out), so the values are the same bit for bit.
+/// cube); a kernel reads only the active terms' results. Each lane does the operations of the
+/// Vec3 expressions it replaces (Eigen's cross, dot and squaredNorm written out) in their order,
+/// so the lane-parallel kernels gave the same bytes as the term-by-term ones they replaced
+/// (without fused multiply-adds, which the default x86-64 target lacks). WinslowKernel::hex
+/// equals its operator() bit for bit; QualityKernel's operator() groups its gradient and
+/// barrier differently, so the two agree up to rounding.
 struct HexTerms {
   alignas(16) double e[3][3][kLanes];  ///< e[k][a][i]: component a of edge vector k of term i
   alignas(16) double d[3][3][kLanes];  ///< d[k][a][i]: component a of d det / d e_k
@@ -361,9 +365,9 @@ struct QualityKernel {
     return f + mu * fw;
   }
 
-
-  /// Batched over the terms of one hex like WinslowKernel::hex; vmin receives the min s. +inf
-  /// (and no gradient) when a term is degenerate or at or below the floor.
+  /// The sum over the terms of one hex whose bit is set in `mask` (lane-parallel on HexTerms, as
+  /// WinslowKernel::hex), the gradient added per local point into g; vmin receives the min s.
+  /// +inf (and no gradient) when an active term is degenerate or at or below the floor.
   double hex(const Vec3 (&p)[8], unsigned mask, Vec3 (&g)[8], double& vmin) const {
     HexTerms t;
     t.load(p);
