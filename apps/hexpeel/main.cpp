@@ -369,7 +369,9 @@ int main(int argc, char** argv) {
                    "other elimination orders tried when the mesh keeps hexes with scaled "
                    "Jacobian <= 0, or elimination gets stuck (not for lack of time) or an "
                    "intrusion is refused (the other side rule, the other method, both; each with "
-                   "the whole plan budget); the best mesh is kept; 0 = only the given order")
+                   "the whole plan budget); when concave steps had to be extruded because their "
+                   "intrusion was refused, the other side rule (Kremer method) is tried too; the "
+                   "best mesh is kept; 0 = only the given order")
       ->check(CLI::Range(0, 3))->capture_default_str();
   mesh->add_flag("--alternatives-always", params.alternatives_always,
                  "try the alternative orders even when the first mesh is valid and keep the one "

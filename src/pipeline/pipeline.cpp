@@ -150,6 +150,17 @@ bool order_may_help(const MeshResult& r, const MeshParams& params) {
          (r.status.code == StatusCode::stuck || r.status.code == StatusCode::invalid_intrusion);
 }
 
+/// Whether r's reconstruction extruded concave steps whose intrusion it refused: their layers go
+/// outward where the method meant them inward, and must fold into the concave region (screw2's
+/// worst hexes, 0.031, are there). The other side rule plans the surface differently, which may
+/// intrude those steps or place their layers better (on screw2 it refuses the same five steps
+/// but ends at 0.057 / 0.622 instead of 0.031 / 0.606); the original method, with no concave
+/// steps, folds such layers more (on screw2 it keeps hexes <= 0), so only the Kremer alternative
+/// is tried for this.
+bool refused_intrusions(const MeshResult& r) {
+  return r.status.ok() && !r.reconstruction.invalid_intrusion_steps.empty();
+}
+
 double total_seconds(const MeshTimings& t) {
   return t.elimination_s + t.reconstruction_s + t.pillow_s + t.placement_s + t.untangle_s +
          t.quality_s;
@@ -220,10 +231,13 @@ MeshResult run_mesh(const PolygonSoup& soup, const MeshParams& params, const Con
   double others_s = 0.0;
   const std::vector<OrderParams> alternatives = alternative_orders(params.elimination.order);
   for (int i = 0; i < params.alternatives && i < static_cast<int>(alternatives.size()); ++i) {
-    if (!params.alternatives_always && !order_may_help(best, params)) break;
-    const char* why = !order_may_help(best, params) ? "looking for a better mesh"
-                      : best.status.ok()        ? "the mesh keeps hexes with scaled Jacobian <= 0"
-                                                : "elimination failed";
+    const bool invalid = order_may_help(best, params);
+    const bool refused = alternatives[i].method == Method::kremer && refused_intrusions(best);
+    if (!params.alternatives_always && !invalid && !refused) break;
+    const char* why = invalid ? (best.status.ok() ? "the mesh keeps hexes with scaled Jacobian <= 0"
+                                                  : "elimination failed")
+                      : refused ? "concave steps were extruded (their intrusion refused)"
+                                : "looking for a better mesh";
     ctx.info(std::string(why) + ": trying elimination order " + describe(alternatives[i]));
     t = std::chrono::steady_clock::now();
     MeshResult r = mesh_with_order(diagnosis, params, alternatives[i], ctx, plans, same_as);

@@ -238,6 +238,38 @@ TEST(Reconstruction, OtherOrdersGetPastARefusedIntrusion) {
   EXPECT_GT(rescued, 0);
 }
 
+// When the given order's reconstruction extrudes a concave step whose intrusion it refused, the
+// other side rule is tried as well (not the original method, which has no concave steps) and
+// the better mesh kept; with no refusal, or with --alternatives 0, nothing else is tried.
+TEST(Reconstruction, RefusedIntrusionTriesTheOtherSideRule) {
+  int refused = 0, clean = 0;
+  for (const char* shape : {"U", "L", "T", "stairs", "steps"}) {
+    ht::Generated g = ht::named_solid(shape, 2);
+    MeshParams one = loose_strict_params();
+    one.reconstruction.fallback_to_extrusion = true;  // extrude refused steps (the default)
+    const MeshResult first = run_mesh(to_polygon_soup(g.surface), one);
+    ASSERT_TRUE(first.status.ok()) << g.name << ": " << to_string(first.status);
+    ASSERT_EQ(first.tries.size(), 1u);
+    MeshParams more = one;
+    more.alternatives = 3;
+    const MeshResult r = run_mesh(to_polygon_soup(g.surface), more);
+    ASSERT_TRUE(r.status.ok()) << g.name << ": " << to_string(r.status);
+    if (first.reconstruction.invalid_intrusion_steps.empty()) {
+      ++clean;
+      EXPECT_EQ(r.tries.size(), 1u) << g.name;
+      continue;
+    }
+    ++refused;
+    ASSERT_EQ(r.tries.size(), 2u) << g.name;
+    EXPECT_EQ(r.tries[1].method, Method::kremer);
+    EXPECT_NE(r.tries[1].side_rule, r.tries[0].side_rule);
+    EXPECT_GE(r.quality.sj_min, first.quality.sj_min) << g.name;
+    QualityReport q = run_quality(r.mesh, {}, &g.surface);
+    EXPECT_TRUE(q.is_ball && q.boundary_matches_surface == true) << g.name;
+  }
+  EXPECT_GT(refused, 0);
+}
+
 TEST(Order, KremerOnVoxelSolidsMeshesWhatOriginalMeshes) {
   std::vector<ht::Generated> gs;
   for (const char* shape : {"L", "U", "T", "pocket", "notch", "stairs", "steps"})
