@@ -136,17 +136,21 @@ MeshResult mesh_with_order(const SurfaceDiagnosis& diagnosis, const MeshParams& 
   return r;
 }
 
+/// Whether r's order ran out of its time (the planner's budget, greedy's time limit): that ends
+/// the tries, the limit is the user's.
+bool ran_out_of_time(const MeshResult& r, const MeshParams& params) {
+  return params.search ? r.planner.budget_exhausted
+                       : params.elimination.time_limit_s > 0 &&
+                             r.timings.elimination_s >= params.elimination.time_limit_s;
+}
+
 /// Whether another elimination order may do better than r: its untangled mesh keeps hexes with
-/// SJ <= 0, or the order itself failed (stuck, or an intrusion that --strict-intrusion refuses).
-/// A placement that was not untangled is expected to keep inverted hexes. An order that ran out
-/// of its time (the planner's budget, greedy's time limit) ends the tries: the limit is the user's.
+/// SJ <= 0, or the order itself failed (stuck, or an intrusion that --strict-intrusion refuses)
+/// without running out of time. A placement that was not untangled is expected to keep inverted
+/// hexes.
 bool order_may_help(const MeshResult& r, const MeshParams& params) {
   if (r.status.ok()) return params.untangle.untangle && r.quality.sj_count_nonpositive > 0;
-  const bool out_of_time =
-      params.search ? r.planner.budget_exhausted
-                    : params.elimination.time_limit_s > 0 &&
-                          r.timings.elimination_s >= params.elimination.time_limit_s;
-  return !out_of_time &&
+  return !ran_out_of_time(r, params) &&
          (r.status.code == StatusCode::stuck || r.status.code == StatusCode::invalid_intrusion);
 }
 
@@ -156,9 +160,10 @@ bool order_may_help(const MeshResult& r, const MeshParams& params) {
 /// intrude those steps or place their layers better (on screw2 it refuses the same five steps
 /// but ends at 0.057 / 0.622 instead of 0.031 / 0.606); the original method, with no concave
 /// steps, folds such layers more (on screw2 it keeps hexes <= 0), so only the Kremer alternative
-/// is tried for this.
-bool refused_intrusions(const MeshResult& r) {
-  return r.status.ok() && !r.reconstruction.invalid_intrusion_steps.empty();
+/// is tried for this. Not when the order ran out of its time, as above.
+bool refused_intrusions(const MeshResult& r, const MeshParams& params) {
+  return r.status.ok() && !r.reconstruction.invalid_intrusion_steps.empty() &&
+         !ran_out_of_time(r, params);
 }
 
 double total_seconds(const MeshTimings& t) {
@@ -232,7 +237,7 @@ MeshResult run_mesh(const PolygonSoup& soup, const MeshParams& params, const Con
   const std::vector<OrderParams> alternatives = alternative_orders(params.elimination.order);
   for (int i = 0; i < params.alternatives && i < static_cast<int>(alternatives.size()); ++i) {
     const bool invalid = order_may_help(best, params);
-    const bool refused = alternatives[i].method == Method::kremer && refused_intrusions(best);
+    const bool refused = alternatives[i].method == Method::kremer && refused_intrusions(best, params);
     if (!params.alternatives_always && !invalid && !refused) break;
     const char* why = invalid ? (best.status.ok() ? "the mesh keeps hexes with scaled Jacobian <= 0"
                                                   : "elimination failed")
