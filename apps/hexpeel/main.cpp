@@ -340,7 +340,7 @@ int main(int argc, char** argv) {
   mesh->add_option("--regularization", params.untangle.regularization,
                    "weight of the Winslow size term in the optimization passes: lower raises the "
                    "minimum scaled Jacobian on many meshes at some cost in the mean (screw2 with "
-                   "0.003: 0.049 / 0.602 instead of 0.031 / 0.606; pierrot 0.362 / 0.784 instead "
+                   "--alternatives 0 and 0.003: 0.049 / 0.602 instead of 0.031 / 0.606; pierrot 0.362 / 0.784 instead "
                    "of 0.339 / 0.799)")
       ->check(CLI::Range(0.0, 1.0))->capture_default_str();
   mesh->add_option("--final-polish-runs", params.untangle.final_polish_runs,
@@ -351,13 +351,13 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0, 100))->capture_default_str();
   mesh->add_option("--final-polish-rounds", params.untangle.final_polish_rounds,
                    "rounds of final polish and mean sweeps, each from where the last left off and "
-                   "kept only if it raises the mean scaled Jacobian (3: screw2's mean 0.606 -> "
+                   "kept only if it raises the mean scaled Jacobian (3: screw2's mean with --alternatives 0 0.606 -> "
                    "0.620, 32% more time on 77 test surfaces)")
       ->check(CLI::Range(1, 100))->capture_default_str();
   bool no_mean_sweep = false;
   mesh->add_flag("--no-mean-sweep", no_mean_sweep,
                  "skip the local sweeps over every interior vertex that end the optimization "
-                 "(they raise the mean scaled Jacobian: screw2 0.521 -> 0.606 with the final polish, "
+                 "(they raise the mean scaled Jacobian: screw2 with --alternatives 0: 0.521 -> 0.606 with the final polish, "
                  "which runs only before them; a 10k-hex jittered "
                  "sphere untangles in 0.6 s without them, 1.1 s with)");
   std::string solver = "lbfgs";

@@ -822,29 +822,34 @@ int64_t local_max_min(const Problem& prob, std::vector<Vec3>& pts, const Untangl
                      [&](int32_t a, int32_t b) { return color[a] < color[b]; });
     return verts;
   };
-  // Searches the vertices of `verts` (sorted by colour) for the mean alone, down to steps of
-  // `stop` times their scale: colour after colour, the vertices of a colour in parallel (they
-  // share no hex, so each reads only hexes no other one moves). Returns the moves.
-  auto sweep_colours = [&](const std::vector<int32_t>& verts, double stop) {
+  // Searches the vertices of `verts` group after group (group(i) is verts[i]'s; each group a
+  // run of equal values, the runs in order), the vertices of one group in parallel: no two of a
+  // group may share a hex, so each reads only hexes no other one moves. Returns the moves.
+  auto search_groups = [&](const std::vector<int32_t>& verts, auto&& group, double stop, double w) {
     moved.assign(verts.size(), 0);
     for (size_t b = 0; b < verts.size();) {
       size_t e = b;
-      while (e < verts.size() && color[verts[e]] == color[verts[b]]) ++e;
+      while (e < verts.size() && group(e) == group(b)) ++e;
       tbb::parallel_for(tbb::blocked_range<size_t>(b, e, 4),
                         [&](const tbb::blocked_range<size_t>& r) {
                           for (size_t i = r.begin(); i != r.end(); ++i)
-                            moved[i] = search(verts[i], stop, kMeanOnly);
+                            moved[i] = search(verts[i], stop, w);
                         });
       b = e;
     }
     return std::accumulate(moved.begin(), moved.end(), int64_t{0});
+  };
+  // Searches the vertices of `verts` (sorted by colour) for the mean alone, down to steps of
+  // `stop` times their scale, colour after colour.
+  auto sweep_colours = [&](const std::vector<int32_t>& verts, double stop) {
+    return search_groups(verts, [&](size_t i) { return color[verts[i]]; }, stop, kMeanOnly);
   };
   // Searches the vertices of `verts` in their order, as one after the other would, but in
   // parallel where that gives the same result: a search reads and moves only points of its
   // vertex's hexes, so a vertex that shares no hex with an earlier one still to run may run
   // now. A vertex's level is one above the highest level of the earlier vertices it shares a
   // hex with (0 when there are none), so two of one level share no hex; the levels run in
-  // order, the vertices of one in parallel. Returns the moves.
+  // order. Returns the moves.
   std::vector<int32_t> hex_level(nh), level, by_level;
   auto search_in_order = [&](const std::vector<int32_t>& verts, double stop, double w) {
     const size_t n = verts.size();
@@ -861,17 +866,9 @@ int64_t local_max_min(const Problem& prob, std::vector<Vec3>& pts, const Untangl
     std::iota(by_level.begin(), by_level.end(), 0);
     std::stable_sort(by_level.begin(), by_level.end(),
                      [&](int32_t a, int32_t b) { return level[a] < level[b]; });
-    moved.assign(n, 0);
-    for (size_t b = 0; b < n;) {
-      size_t e = b;
-      while (e < n && level[by_level[e]] == level[by_level[b]]) ++e;
-      tbb::parallel_for(tbb::blocked_range<size_t>(b, e, 1), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t i = r.begin(); i != r.end(); ++i)
-          moved[by_level[i]] = search(verts[by_level[i]], stop, w);
-      });
-      b = e;
-    }
-    return std::accumulate(moved.begin(), moved.end(), int64_t{0});
+    std::vector<int32_t> ordered(n);
+    for (size_t i = 0; i < n; ++i) ordered[i] = verts[by_level[i]];
+    return search_groups(ordered, [&](size_t i) { return level[by_level[i]]; }, stop, w);
   };
   std::vector<uint8_t> in_worst(np, 0);
   int64_t moves = 0;
@@ -1188,21 +1185,25 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
     // the sweeps left the points; it is undone if it ends with a lower minimum, or lowers the
     // mean more than it raises the minimum (weighed as the sweeps weigh them, local_mean_weight),
     // and the passes stop once one raises the minimum by less than quality_pass_gain.
-    // A point to come back to: x, the mean hex value there (prob.pos must hold x) and the
-    // sweeps' move count, which an undo restores with it.
+    // A point to come back to: x, the mean hex value there (prob.pos must hold x), and the
+    // sweeps' move count and mean_polish_kept, which an undo restores with it.
     struct Checkpoint {
       Eigen::VectorXd x;
       double mean = 0.0;
       int64_t moves = 0;
+      bool mean_polish_kept = false;
     };
-    auto checkpoint = [&] { return Checkpoint{x, mean_hex_value(), res.stats.local_moves}; };
-    auto restore = [&](const Checkpoint& c) { x = c.x, res.stats.local_moves = c.moves; };
+    auto checkpoint = [&] {
+      return Checkpoint{x, mean_hex_value(), res.stats.local_moves, res.stats.mean_polish_kept};
+    };
+    auto restore = [&](const Checkpoint& c) {
+      x = c.x, res.stats.local_moves = c.moves, res.stats.mean_polish_kept = c.mean_polish_kept;
+    };
     const int passes = std::max(1, params.quality_passes);
     Checkpoint at_pass;
-    bool kept_pass = false;  // mean_polish_kept at the pass's start, for an undo
     for (int pass = 0; pass < passes; ++pass) {
       const double s_pass = smin;
-      if (pass > 0) at_pass = checkpoint(), kept_pass = res.stats.mean_polish_kept;
+      if (pass > 0) at_pass = checkpoint();
       run_restarts(pass, passes);
       bool polish_kept = false;
       run_polish(0.0, k.mu, 1, polish_kept);
@@ -1215,7 +1216,6 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
                                                 (mean_hex_value() - at_pass.mean) < 0.0)) {
         restore(at_pass);
         prob.evaluate(x, g, k);
-        res.stats.mean_polish_kept = kept_pass;
         break;
       }
       smin = s_end;
