@@ -281,12 +281,14 @@ int main(int argc, char** argv) {
                    "greedy: one greedy pass in the order rules' order (the paper's method)")
       ->check(CLI::IsMember({"search", "greedy"}))->capture_default_str();
   mesh->add_option("--plan-budget", params.planner.budget_s,
-                   "wall-clock budget of the search (s); the search stops earlier when its "
-                   "strategies are done. A run that hits the budget may depend on machine speed")
+                   "budget of the search, in budget seconds: work counted deterministically "
+                   "(feasibility tests weighted by chord length), about a wall-clock second each "
+                   "on the reference machine (2 cores), so the plan never depends on machine speed "
+                   "or load; the search stops earlier when its strategies are done")
       ->check(CLI::PositiveNumber)->capture_default_str();
   mesh->add_option("--improve-budget", params.planner.improve_budget_s,
-                   "seconds (within --plan-budget) spent looking for a cheaper plan when the first "
-                   "one needed backtracking; 0 = keep the first plan")
+                   "budget seconds (within --plan-budget) spent looking for a cheaper plan when "
+                   "the first one needed backtracking; 0 = keep the first plan")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
   mesh->add_option("--seed", params.planner.seed, "seed of the search's randomized restarts")
       ->capture_default_str();

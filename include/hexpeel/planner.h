@@ -3,7 +3,9 @@
 //
 // The surface after eliminating a set of chords depends only on the set, so search states are
 // memoized by the set (a Zobrist hash) and the side of a step changes only the plan's cost, never
-// what is feasible later. The portfolio, within a time budget:
+// what is feasible later. The portfolio, within a budget of work (feasibility tests weighted by
+// chord length, in "budget seconds" of about a wall-clock second each on the reference machine;
+// no clock is read, so the plan never depends on machine speed or load):
 //   1. cost-guided greedy in the OrderPolicy's order; when stuck, a complete depth-first search
 //      over the last k steps (k = 1..window) with dead states remembered;
 //   2. when that found no plan: conflict-directed search (chords left at stuck states gain
@@ -26,9 +28,11 @@ namespace hexpeel {
 struct PlannerParams {
   OrderParams order;            ///< priorities and side rule (run_mesh passes its own, with
                                 ///< SideRule::cost, the planner's default)
-  double budget_s = 30.0;       ///< wall-clock budget of the whole search (s, > 0)
-  /// Time for looking for a cheaper plan once one was found by backtracking (beam + restarts),
-  /// within budget_s (s, >= 0).
+  /// Budget of the whole search in budget seconds (> 0): work, counted deterministically, of
+  /// about a wall-clock second each on the reference machine (0.75-1.1 s measured).
+  double budget_s = 30.0;
+  /// Budget for looking for a cheaper plan once one was found by backtracking (beam + restarts),
+  /// within budget_s (budget seconds, >= 0).
   double improve_budget_s = 10.0;
   uint64_t seed = 1;            ///< seed of the randomized restarts
   double flat_penalty = 0.0;    ///< cost per flat step, in hexes; 0 = the quad count of the input

@@ -75,9 +75,22 @@ struct Search {
   bool aborted = false;       ///< the current phase (or the whole budget) ran out
   double phase_end_s = 0.0;   ///< end of the current phase, seconds from start
 
+  /// The search's work so far: every feasibility test adds kTestWork plus its chord's length.
+  /// Budgets and phases are measured in this, never in wall-clock time, so the plan found is the
+  /// same on any machine, under any load and for any thread count.
+  int64_t work = 0;
+  static constexpr int64_t kTestWork = 18;
+  /// Work per budget second: on the reference machine (2 cores, see README) a budget second took
+  /// 0.75-1.1 s of planning on pierrot, screw2 and two 3-6k-quad real surfaces (least squares
+  /// over those and 77 small surfaces: 5.2e-7 s per unit of chord length tested, 9.6e-6 s per
+  /// test).
+  static constexpr double kWorkPerSecond = 1.9e6;
+
   double elapsed() const { return std::chrono::duration<double>(Clock::now() - start).count(); }
+  /// The work done so far in budget seconds.
+  double effort() const { return static_cast<double>(work) / kWorkPerSecond; }
   bool out_of_time() {
-    if (!aborted && elapsed() > std::min(phase_end_s, params.budget_s)) {
+    if (!aborted && effort() > std::min(phase_end_s, params.budget_s)) {
       aborted = true;
       stats.budget_exhausted = true;
     }
@@ -86,7 +99,7 @@ struct Search {
   /// Starts a phase that may use up to `fraction` of the whole budget from now; false when the
   /// budget is spent. Phases keep one strategy (a deep windowed search) from starving the others.
   bool begin_phase(double fraction) {
-    const double now = elapsed();
+    const double now = effort();
     if (now >= params.budget_s) return false;
     aborted = false;
     phase_end_s = std::min(params.budget_s, now + fraction * params.budget_s);
@@ -161,6 +174,7 @@ struct Search {
         auto [m, sides] = heap_.top();
         heap_.pop();
         if (sides == 0) {
+          s_.work += kTestWork + s_.st.chord_length(m.chord);
           auto f = s_.st.feasibility(m.chord);
           if (!f.ok()) continue;
           Move full = s_.policy.full(s_.st, m.chord, f.sides);
@@ -200,7 +214,7 @@ struct Search {
         return false;
       }
       push(*s);
-      ctx.report("planning", std::min(1.0, elapsed() / params.budget_s));
+      ctx.report("planning", std::min(1.0, effort() / params.budget_s));
     }
     return true;
   }
@@ -358,7 +372,7 @@ struct Search {
         next.push_back(std::move(n));
       }
       level = std::move(next);
-      ctx.report("planning", std::min(1.0, elapsed() / params.budget_s));
+      ctx.report("planning", std::min(1.0, effort() / params.budget_s));
     }
   }
 };
@@ -379,15 +393,15 @@ PlannerResult run_planner(EliminationState& state, const PlannerParams& params, 
   // 3-4. A plan that needed rescuing (its tail came from backtracking, not from the priorities):
   // beam search and randomized restarts look for a cheaper one, within improve_budget_s.
   if (!s.best.empty() && params.improve && s.stats.stuck_events > 0) {
-    const double improve_end = std::min(params.budget_s, s.elapsed() + params.improve_budget_s);
+    const double improve_end = std::min(params.budget_s, s.effort() + params.improve_budget_s);
     auto begin = [&](double seconds) {
-      seconds = std::min(seconds, improve_end - s.elapsed());
+      seconds = std::min(seconds, improve_end - s.effort());
       return seconds > 0 && s.begin_phase(seconds / params.budget_s);
     };
     if (begin(0.3 * params.improve_budget_s)) s.beam();
     uint64_t seeder = params.seed;
     for (int r = 0; r < params.restarts; ++r) {
-      if (!begin((improve_end - s.elapsed()) / (params.restarts - r))) break;
+      if (!begin((improve_end - s.effort()) / (params.restarts - r))) break;
       uint64_t noise_seed = splitmix(seeder) | 1;
       if (s.greedy_with_window(noise_seed, "restart")) s.unwind();
     }

@@ -11,7 +11,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
+#include <optional>
+#include <thread>
 
 using namespace hexpeel;
 namespace ht = hexpeel::testing;
@@ -125,4 +128,42 @@ TEST(Planner, ConflictSearchRescuesStuckGreedy) {
   }
   std::printf("conflict search: %d of %d stuck greedy descents rescued\n", rescued, stuck);
   EXPECT_GT(stuck, 0) << "no surface made greedy stuck: the test shows nothing";
+}
+
+TEST(Planner, BudgetCountsWorkNotTime) {
+  // The budget is work, not wall-clock time: a search slowed down (here by a progress callback
+  // that sleeps) must explore exactly as far and keep the same plan when its budget runs out.
+  // The first generated surface whose greedy descent gets stuck (so the improve phase runs).
+  std::optional<Prepared> p;
+  for (uint64_t seed = 1; seed <= 24 && !p; ++seed) {
+    ht::Generated g = seed % 2 ? ht::pillowed(ht::random_voxel_solid(seed, 4, 10, 2), seed, 0.3)
+                               : ht::random_voxel_solid(seed, 5, 8 + 2 * static_cast<int>(seed), 1);
+    Prepared q = prepare(g.surface);
+    EliminationState st(q.surface, q.chords, q.edges);
+    if (run_planner(st, convex_only()).stats.stuck_events > 0) p = std::move(q);
+  }
+  ASSERT_TRUE(p) << "no surface made greedy stuck: the improve budget is never used";
+  PlannerParams pp = convex_only();
+  pp.improve_budget_s = 0.002;
+  auto run = [&](const Context& ctx, std::vector<std::pair<int32_t, int>>& steps) {
+    EliminationState st(p->surface, p->chords, p->edges);
+    PlannerResult r = run_planner(st, pp, ctx);
+    for (const PlanStep& s : r.plan.steps) steps.push_back({s.chord, s.side});
+    return r.stats;
+  };
+  std::vector<std::pair<int32_t, int>> fast_steps, slow_steps;
+  const PlannerStats fast = run({}, fast_steps);
+  Context slow_ctx;
+  slow_ctx.progress = [](std::string_view, double) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  };
+  const PlannerStats slow = run(slow_ctx, slow_steps);
+  std::printf("budget test: %lld nodes, %d plans, fast %.3f s, slow %.3f s\n",
+              static_cast<long long>(fast.nodes), static_cast<int>(fast.plans_tried), fast.time_s,
+              slow.time_s);
+  EXPECT_TRUE(fast.budget_exhausted) << "the budget did not run out: the test shows nothing";
+  EXPECT_GT(slow.time_s, 2.0 * fast.time_s) << "the slowdown did not slow the search";
+  EXPECT_EQ(slow.nodes, fast.nodes);
+  EXPECT_EQ(slow.plans_tried, fast.plans_tried);
+  EXPECT_EQ(slow_steps, fast_steps);
 }
