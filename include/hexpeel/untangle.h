@@ -269,6 +269,9 @@ struct UntangleStats {
   int32_t forced_corners = 0;   ///< left out: all 4 points fixed, or the fixed ones collinear
   int32_t forced_nonpositive = 0;  ///< forced corners with det <= 0: no placement fixes them
   UntanglePhaseStats untangle, optimize;
+  /// phase 2 ended with a lower minimum and ran again without its restarts (the only step that
+  /// can lower it): polish and sweeps from the untangled points
+  bool optimize_restarts_dropped = false;
   bool optimize_reverted = false;  ///< phase 2 made the minimum worse and was undone
   bool mean_polish_kept = false;   ///< a mean polish of phase 2 ran and kept the minimum
   /// steps of phase 2's local sweeps (those of undone passes and of mean sweeps run again

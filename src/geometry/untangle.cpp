@@ -1199,71 +1199,102 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
     auto restore = [&](const Checkpoint& c) {
       x = c.x, res.stats.local_moves = c.moves, res.stats.mean_polish_kept = c.mean_polish_kept;
     };
-    const int passes = std::max(1, params.quality_passes);
-    Checkpoint at_pass;
-    for (int pass = 0; pass < passes; ++pass) {
-      const double s_pass = smin;
-      if (pass > 0) at_pass = checkpoint();
-      run_restarts(pass, passes);
-      bool polish_kept = false;
-      run_polish(0.0, k.mu, 1, polish_kept);
-      res.stats.mean_polish_kept |= polish_kept;
-      if (sweeps) run_sweeps(true, false);
-      prob.evaluate(x, g, k);
-      const double s_end = prob.min_corner_value();
-      ++res.stats.quality_passes;
-      if (pass > 0 && (s_end < s_pass || (s_end - s_pass) + params.local_mean_weight *
-                                                (mean_hex_value() - at_pass.mean) < 0.0)) {
-        restore(at_pass);
+    // The passes and the final polish and mean sweeps, from x. Only the restarts can lower the
+    // minimum (their floor is 0, not the minimum): `restarts` false leaves them out.
+    auto optimize_from = [&](bool restarts) {
+      const int passes = std::max(1, params.quality_passes);
+      Checkpoint at_pass;
+      for (int pass = 0; pass < passes; ++pass) {
+        const double s_pass = smin;
+        if (pass > 0) at_pass = checkpoint();
+        if (restarts) run_restarts(pass, passes);
+        bool polish_kept = false;
+        run_polish(0.0, k.mu, 1, polish_kept);
+        res.stats.mean_polish_kept |= polish_kept;
+        if (sweeps) run_sweeps(true, false);
         prob.evaluate(x, g, k);
-        break;
-      }
-      smin = s_end;
-      if (s_end - s_pass < params.quality_pass_gain) break;
-    }
-    // The final polish only prepares the mean sweeps (see final_polish_runs). When the mean
-    // sweeps from its point end below the mean the passes left, they run again from there.
-    const bool mean_sweeps = sweeps && params.local_all && params.local_polish_stop > 0.0;
-    if (mean_sweeps) {
-      auto final_polish = [&](bool& kept) {
-        return run_polish(params.final_polish_barrier, params.final_polish_regularization,
-                          params.final_polish_runs, kept);
-      };
-      const Checkpoint at_passes = checkpoint();
-      res.stats.final_polish_runs = final_polish(res.stats.final_polish_kept);
-      run_sweeps(false, true);
-      if (res.stats.final_polish_kept) {
-        prob.evaluate(x, g, k);
-        if (mean_hex_value() < at_passes.mean) {
-          restore(at_passes);
-          res.stats.final_polish_kept = false;
-          run_sweeps(false, true);
-        }
-      }
-      // Further rounds of polish and mean sweeps, each from where the last left the points,
-      // kept while one raises the mean.
-      for (int round = 1; round < params.final_polish_rounds && res.stats.final_polish_kept;
-           ++round) {
-        prob.evaluate(x, g, k);
-        const Checkpoint at_round = checkpoint();
-        bool kept = false;
-        res.stats.final_polish_runs += final_polish(kept);
-        if (!kept) break;
-        run_sweeps(false, true);
-        prob.evaluate(x, g, k);
-        if (!(mean_hex_value() > at_round.mean)) {
-          restore(at_round);
+        const double s_end = prob.min_corner_value();
+        ++res.stats.quality_passes;
+        if (pass > 0 && (s_end < s_pass || (s_end - s_pass) + params.local_mean_weight *
+                                                  (mean_hex_value() - at_pass.mean) < 0.0)) {
+          restore(at_pass);
+          prob.evaluate(x, g, k);
           break;
         }
-        ++res.stats.final_polish_rounds;
+        smin = s_end;
+        if (s_end - s_pass < params.quality_pass_gain) break;
       }
-    }
+      // The final polish only prepares the mean sweeps (see final_polish_runs). When the mean
+      // sweeps from its point end below the mean the passes left, they run again from there.
+      const bool mean_sweeps = sweeps && params.local_all && params.local_polish_stop > 0.0;
+      if (mean_sweeps) {
+        auto final_polish = [&](bool& kept) {
+          return run_polish(params.final_polish_barrier, params.final_polish_regularization,
+                            params.final_polish_runs, kept);
+        };
+        const Checkpoint at_passes = checkpoint();
+        res.stats.final_polish_runs = final_polish(res.stats.final_polish_kept);
+        run_sweeps(false, true);
+        if (res.stats.final_polish_kept) {
+          prob.evaluate(x, g, k);
+          if (mean_hex_value() < at_passes.mean) {
+            restore(at_passes);
+            res.stats.final_polish_kept = false;
+            run_sweeps(false, true);
+          }
+        }
+        // Further rounds of polish and mean sweeps, each from where the last left the points,
+        // kept while one raises the mean.
+        for (int round = 1; round < params.final_polish_rounds && res.stats.final_polish_kept;
+             ++round) {
+          prob.evaluate(x, g, k);
+          const Checkpoint at_round = checkpoint();
+          bool kept = false;
+          res.stats.final_polish_runs += final_polish(kept);
+          if (!kept) break;
+          run_sweeps(false, true);
+          prob.evaluate(x, g, k);
+          if (!(mean_hex_value() > at_round.mean)) {
+            restore(at_round);
+            break;
+          }
+          ++res.stats.final_polish_rounds;
+        }
+      }
+    };
+    optimize_from(true);
     res.stats.optimize.evaluations += prob.evaluations - ev0;
     res.stats.optimize.corner_evaluations += prob.corner_evaluations - cev0;
     HexMesh before = res.mesh;
     write_back(x);
-    const HexQuality q2 = hex_quality(res.mesh);
-    if (q2.min < res.stats.optimize.min_sj_before || q2.nonpositive > res.stats.optimize.nonpositive_before) {
+    HexQuality q2 = hex_quality(res.mesh);
+    auto worse = [&] {
+      return q2.min < res.stats.optimize.min_sj_before ||
+             q2.nonpositive > res.stats.optimize.nonpositive_before;
+    };
+    if (worse()) {
+      // The restarts left the minimum lower and nothing recovered it: everything again from the
+      // untangled points without them (the polish and the sweeps, which keep the minimum), so
+      // the mean still gains.
+      res.stats.optimize_restarts_dropped = true;
+      res.stats.local_moves = 0;
+      res.stats.quality_passes = 0;
+      res.stats.mean_polish_kept = res.stats.final_polish_kept = false;
+      res.stats.final_polish_runs = res.stats.final_polish_rounds = 0;
+      const int ev1 = prob.evaluations;
+      const int64_t cev1 = prob.corner_evaluations;
+      x = x_before;
+      k.floor = -std::numeric_limits<double>::infinity();
+      prob.evaluate(x, g, k);
+      smin = prob.min_corner_value();
+      optimize_from(false);
+      res.stats.optimize.evaluations += prob.evaluations - ev1;
+      res.stats.optimize.corner_evaluations += prob.corner_evaluations - cev1;
+      res.mesh = before;
+      write_back(x);
+      q2 = hex_quality(res.mesh);
+    }
+    if (worse()) {
       res.mesh = std::move(before);
       res.stats.optimize_reverted = true;
       res.stats.mean_polish_kept = false;
