@@ -270,7 +270,8 @@ struct UntangleStats {
   int32_t forced_nonpositive = 0;  ///< forced corners with det <= 0: no placement fixes them
   UntanglePhaseStats untangle, optimize;
   /// phase 2 ended with a lower minimum and ran again without its restarts (the only step that
-  /// can lower it): polish and sweeps from the untangled points
+  /// can lower it): polish and sweeps from the untangled points. local_moves, quality_passes and
+  /// the final polish fields then count the second run only; the optimize phase stats both.
   bool optimize_restarts_dropped = false;
   bool optimize_reverted = false;  ///< phase 2 made the minimum worse and was undone
   bool mean_polish_kept = false;   ///< a mean polish of phase 2 ran and kept the minimum

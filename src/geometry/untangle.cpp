@@ -1285,6 +1285,7 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
       const int64_t cev1 = prob.corner_evaluations;
       x = x_before;
       k.floor = -std::numeric_limits<double>::infinity();
+      k.s_ref = 0.0;
       prob.evaluate(x, g, k);
       smin = prob.min_corner_value();
       optimize_from(false);

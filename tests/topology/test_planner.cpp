@@ -140,7 +140,8 @@ TEST(Planner, BudgetCountsWorkNotTime) {
                                : ht::random_voxel_solid(seed, 5, 8 + 2 * static_cast<int>(seed), 1);
     Prepared q = prepare(g.surface);
     EliminationState st(q.surface, q.chords, q.edges);
-    if (run_planner(st, convex_only()).stats.stuck_events > 0) p = std::move(q);
+    const PlannerResult r = run_planner(st, convex_only());
+    if (r.stats.stuck_events > 0 && r.plan.status.ok() && r.stats.strategy == "window") p = std::move(q);
   }
   ASSERT_TRUE(p) << "no surface made greedy stuck: the improve budget is never used";
   PlannerParams pp = convex_only();
@@ -154,7 +155,9 @@ TEST(Planner, BudgetCountsWorkNotTime) {
   std::vector<std::pair<int32_t, int>> fast_steps, slow_steps;
   const PlannerStats fast = run({}, fast_steps);
   Context slow_ctx;
-  slow_ctx.progress = [](std::string_view, double) {
+  int64_t sleeps = 0;
+  slow_ctx.progress = [&sleeps](std::string_view, double) {
+    ++sleeps;
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   };
   const PlannerStats slow = run(slow_ctx, slow_steps);
@@ -162,7 +165,7 @@ TEST(Planner, BudgetCountsWorkNotTime) {
               static_cast<long long>(fast.nodes), static_cast<int>(fast.plans_tried), fast.time_s,
               slow.time_s);
   EXPECT_TRUE(fast.budget_exhausted) << "the budget did not run out: the test shows nothing";
-  EXPECT_GT(slow.time_s, 2.0 * fast.time_s) << "the slowdown did not slow the search";
+  EXPECT_GT(sleeps, 20) << "the slowdown did not slow the search";
   EXPECT_EQ(slow.nodes, fast.nodes);
   EXPECT_EQ(slow.plans_tried, fast.plans_tried);
   EXPECT_EQ(slow_steps, fast_steps);
