@@ -1262,6 +1262,7 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
         }
       }
     };
+    const UntangleStats at_start = res.stats;  // what a run without the restarts starts from
     optimize_from(true);
     res.stats.optimize.evaluations += prob.evaluations - ev0;
     res.stats.optimize.corner_evaluations += prob.corner_evaluations - cev0;
@@ -1276,11 +1277,10 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
       // The restarts left the minimum lower and nothing recovered it: everything again from the
       // untangled points without them (the polish and the sweeps, which keep the minimum), so
       // the mean still gains.
+      const UntanglePhaseStats both_runs = res.stats.optimize;
+      res.stats = at_start;
+      res.stats.optimize = both_runs;
       res.stats.optimize_restarts_dropped = true;
-      res.stats.local_moves = 0;
-      res.stats.quality_passes = 0;
-      res.stats.mean_polish_kept = res.stats.final_polish_kept = false;
-      res.stats.final_polish_runs = res.stats.final_polish_rounds = 0;
       const int ev1 = prob.evaluations;
       const int64_t cev1 = prob.corner_evaluations;
       x = x_before;
@@ -1291,8 +1291,7 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
       optimize_from(false);
       res.stats.optimize.evaluations += prob.evaluations - ev1;
       res.stats.optimize.corner_evaluations += prob.corner_evaluations - cev1;
-      res.mesh = before;
-      write_back(x);
+      write_back(x);  // every free point, so nothing of the first run's stays
       q2 = hex_quality(res.mesh);
     }
     if (worse()) {

@@ -73,7 +73,7 @@ struct Search {
   std::vector<Step> deepest_stuck;
   std::vector<double> activity;  ///< conflict activity per chord (empty outside conflict search)
   bool aborted = false;       ///< the current phase (or the whole budget) ran out
-  double phase_end_s = 0.0;   ///< end of the current phase, seconds from start
+  double phase_end_s = 0.0;   ///< end of the current phase, in budget seconds (effort())
 
   /// The search's work so far: every feasibility test adds kTestWork plus its chord's length.
   /// Budgets and phases are measured in this, never in wall-clock time, so the plan found is the
