@@ -1094,6 +1094,7 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
     // passes place the progress report.
     auto run_restarts = [&](int pass, int passes) {
       for (int round = 0; round < params.max_quality_rounds; ++round) {
+        const int32_t iterations_before = res.stats.optimize.iterations;
         k.s_ref = smin;
         // Positive meshes stay positive; a mesh with inverted corners may not get worse.
         k.floor = smin > 0 ? 0.0 : smin - 1e-12;
@@ -1128,7 +1129,14 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
         const double s = prob.min_corner_value();
         ++res.stats.optimize.rounds;
         ctx.report("optimize", (pass + (round + 1.0) / params.max_quality_rounds) / passes);
-        const bool done = s - smin < 1e-3;
+        // Done when a restart gains little, or gains less than restart_slow_gain in all of its
+        // iterations: the sweeps and the next pass lift such a slow climb for less.
+        const bool out_of_iterations =
+            res.stats.optimize.iterations - iterations_before >= params.max_quality_inner;
+        const bool done =
+            s - smin < 1e-3 || (out_of_iterations && s - smin < params.restart_slow_gain);
+        if (out_of_iterations && s - smin >= 1e-3 && s - smin < params.restart_slow_gain)
+          res.stats.restarts_ended_slow = true;
         smin = std::max(smin, s);
         if (done) break;
       }

@@ -403,6 +403,7 @@ nlohmann::json to_json(const MeshResult& r) {
                      {"final_eps", u.final_eps},
                      {"untangle", phase(u.untangle)},
                      {"optimize", phase(u.optimize)},
+                     {"restarts_ended_slow", u.restarts_ended_slow},
                      {"optimize_restarts_dropped", u.optimize_restarts_dropped},
                      {"optimize_reverted", u.optimize_reverted},
                      {"mean_polish_kept", u.mean_polish_kept},

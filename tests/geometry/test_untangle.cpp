@@ -610,6 +610,27 @@ TEST(GeometryPipeline, DroppedFinalPolishGivesTheSameMesh) {
                         a.mesh.points.size() * sizeof(Vec3)), 0);
 }
 
+// A restart that runs out of iterations while gaining less than restart_slow_gain ends the
+// restarts: on this equiangular cubed sphere the later restarts are such slow climbs, and the
+// sweeps and the second pass reach the same minimum without them (measured: 0.76954 ->
+// 0.76955, mean 0.94697 -> 0.94718, fewer restarts; the figures are printed below).
+TEST(GeometryPipeline, SlowRestartsEndTheRestarts) {
+  const Generated g = testing::cubed_sphere_equiangular(8);
+  MeshParams p;
+  p.untangle.restart_slow_gain = 0.0;
+  const auto [a, b] = mesh_with_and_without(g, p);
+  ASSERT_TRUE(a.status.ok() && b.status.ok()) << to_string(b.status);
+  std::printf("without / with: min %.5f / %.5f, mean %.5f / %.5f, restarts %d / %d\n",
+              a.quality.sj_min, b.quality.sj_min, a.quality.sj_mean, b.quality.sj_mean,
+              a.untangle.optimize.rounds, b.untangle.optimize.rounds);
+  EXPECT_FALSE(a.untangle.restarts_ended_slow);
+  EXPECT_TRUE(b.untangle.restarts_ended_slow);
+  EXPECT_LT(b.untangle.optimize.rounds, a.untangle.optimize.rounds);
+  EXPECT_GE(b.quality.sj_min, a.quality.sj_min - 1e-4);
+  EXPECT_GE(b.quality.sj_mean, a.quality.sj_mean - 1e-3);
+  EXPECT_EQ(b.quality.sj_count_nonpositive, 0);
+}
+
 // The local max-min sweeps at the end of phase 2 raise the minimum (never lower it) and keep
 // the boundary. A pillowed voxel solid, whose worst hex has free corners (measured: 0.237 ->
 // 0.287 with the sweeps).
