@@ -8,7 +8,7 @@
 //                [--no-false-positive] [--no-concave-waits] [--strict-intrusion]
 //                [--pillow auto|all|none] [--no-untangle] [--no-optimize]
 //                [--polish-iterations N] [--quality-passes N] [--regularization W]
-//                [--final-polish-runs N] [--final-polish-rounds N]
+//                [--final-polish-runs N] [--final-polish-softmin G] [--final-polish-rounds N]
 //                [--no-mean-sweep]
 //                [--solver lbfgs|newton] [--alternatives N]
 //                [--alternatives-always] [--threads N] [--quiet]
@@ -351,6 +351,11 @@ int main(int argc, char** argv) {
                    "before the mean sweeps (so not with --no-mean-sweep); a further run only when "
                    "the last did not converge; 0 = skip it, for speed")
       ->check(CLI::Range(0, 100))->capture_default_str();
+  mesh->add_option("--final-polish-softmin", params.untangle.final_polish_softmin,
+                   "sharpness of the final polish's mean term, a soft minimum over each hex's nine "
+                   "scaled Jacobian terms, so that it lifts each hex's worst term (the hex's "
+                   "scaled Jacobian); 0 = the passes' term, which lifts all nine alike")
+      ->check(CLI::Range(0.0, 1000.0))->capture_default_str();
   mesh->add_option("--final-polish-rounds", params.untangle.final_polish_rounds,
                    "rounds of final polish and mean sweeps, each from where the last left off and "
                    "kept only if it raises the mean scaled Jacobian (3: screw2's mean with --alternatives 0 0.606 -> "

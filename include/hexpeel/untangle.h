@@ -203,6 +203,17 @@ struct UntangleParams {
   /// pierrot 0.7972 -> 0.7989, screw2 0.5864 -> 0.6059. 0.001 and 0.003 did about as well on
   /// three of them, 0.0003 and 0 worse (gear 0.868, 0.831).
   double final_polish_regularization = 2e-3;
+  /// The final polish's mean term: with final_polish_softmin gamma > 0, each hex's softmin over
+  /// its terms (QualityKernel::mean_softmin) weighed final_polish_softmin_weight, which lifts each
+  /// hex's worst term, the one its scaled Jacobian is; 0 = the passes' flat per-term exponential
+  /// (mean_beta, mean_weight), which lifts all nine terms alike. Against 0, on 61 generated,
+  /// CAD-like and real surfaces: mean higher on 16 (pillowed voxel solids up to +0.008, a
+  /// cylinder 0.8105 -> 0.8138), lower on 2 (10,400-hex cubed sphere 0.9826 -> 0.9815), minima
+  /// the same but for 2 (by <= 0.0003); pierrot 0.7989 -> 0.8058, screw2 0.6162 -> 0.6211.
+  /// Weights 4-7 gave pierrot 0.8054-0.8066 with all 3 runs made, but the delta test
+  /// (inner_delta) can end the first run early, which left weights 4 and 8 at 0.791.
+  double final_polish_softmin = 50.0;
+  double final_polish_softmin_weight = 6.0;
   /// Rounds of final polish and mean sweeps (>= 1): each further round starts from where the
   /// last left the points and is kept only if it raises the mean (over the hexes of their worst
   /// active term); the rounds stop at the first that does not, or when the first polish was not

@@ -1145,9 +1145,11 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
     // nearly alike. The hexes within mean_pin of the minimum keep all 8 vertices where they are,
     // every other corner must stay above the minimum, and the polish is undone if the minimum
     // still ends lower. `barrier` adds the kernel's log barrier at that floor, `mu` weighs the
-    // Winslow regularizer; up to `runs` L-BFGS runs while one ends unconverged. Sets `kept` when
-    // the result stays; returns the runs made.
-    auto run_polish = [&](double barrier, double mu, int runs, bool& kept) {
+    // Winslow regularizer; `softmin` > 0 makes the mean term each hex's softmin
+    // (QualityKernel::mean_softmin) weighed `softmin_weight`; up to `runs` L-BFGS runs while one
+    // ends unconverged. Sets `kept` when the result stays; returns the runs made.
+    auto run_polish = [&](double barrier, double mu, double softmin, double softmin_weight,
+                          int runs, bool& kept) {
       if (runs <= 0 || params.max_mean_inner <= 0 || !(params.mean_weight > 0.0) ||
           !(params.mean_pin > 0.0) || !(smin > 0.0))
         return 0;
@@ -1163,7 +1165,8 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
       km.s_ref = s_now;
       km.floor = s_now;  // the hexes it evaluates start at >= s_now + mean_pin (the rest pinned)
       km.mean_beta = params.mean_beta;
-      km.mean_weight = params.mean_weight;
+      km.mean_weight = softmin > 0.0 ? softmin_weight : params.mean_weight;
+      km.mean_softmin = softmin;
       km.barrier = barrier;
       km.mu = mu;
       int32_t ns = 0;
@@ -1217,7 +1220,7 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
         if (pass > 0) at_pass = checkpoint();
         if (restarts) run_restarts(pass, passes);
         bool polish_kept = false;
-        run_polish(0.0, k.mu, 1, polish_kept);
+        run_polish(0.0, k.mu, 0.0, 0.0, 1, polish_kept);
         res.stats.mean_polish_kept |= polish_kept;
         if (sweeps) run_sweeps(true, false);
         prob.evaluate(x, g, k);
@@ -1238,6 +1241,7 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
       if (mean_sweeps) {
         auto final_polish = [&](bool& kept) {
           return run_polish(params.final_polish_barrier, params.final_polish_regularization,
+                            params.final_polish_softmin, params.final_polish_softmin_weight,
                             params.final_polish_runs, kept);
         };
         const Checkpoint at_passes = checkpoint();

@@ -24,6 +24,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <iterator>
 #include <limits>
 
 namespace hexpeel::untangle_detail {
@@ -323,6 +324,13 @@ struct QualityKernel {
   /// small mean_beta every corner weighs nearly alike, which keeps the typical corner up while
   /// beta's term lifts the worst (0 = off).
   double mean_beta = 0.0, mean_weight = 0.0;
+  /// With mean_softmin gamma > 0 (hex() only; operator() sees one term and ignores it) the mean
+  /// term is per hex instead: mean_weight (-softmin) of the hex's active terms s_i, where
+  /// softmin = m - log(sum_i exp(-gamma (s_i - m))) / gamma <= m = min_i s_i, and mean_beta is
+  /// unused. Its gradient lifts each hex's worst terms (weights softmax(-gamma s), summing to 1
+  /// per hex), so it raises the mean of the hexes' scaled Jacobians, their worst terms, where the
+  /// flat per-term exponential lifts all nine terms alike.
+  double mean_softmin = 0.0;
   /// A log barrier: + barrier (-log(s - floor)) per term (0 = off; needs a finite floor). The
   /// floor alone is a wall the energy does not see coming: L-BFGS steps keep hitting it and the
   /// line search cuts them to almost nothing; the barrier's gradient turns them away first.
@@ -395,8 +403,23 @@ struct QualityKernel {
     // The exponentials (library calls) of the active terms only.
     double ex[kLanes], ex2[kLanes];
     for (int i = 0; i < kHexTerms; ++i) ex[i] = mask >> i & 1u ? std::exp(beta * (s_ref - s[i])) : 0.0;
-    for (int i = 0; i < kHexTerms; ++i)
-      ex2[i] = mean_weight != 0.0 && (mask >> i & 1u) ? mean_weight * std::exp(mean_beta * (s_ref - s[i])) : 0.0;
+    // The per-hex softmin's value and its derivatives in s (lane-parallel but for the sums).
+    double soft_value = 0.0, soft_k[kLanes] = {};
+    if (mean_softmin > 0.0 && mean_weight != 0.0) {
+      double m = std::numeric_limits<double>::infinity(), z[kLanes] = {}, sum = 0.0;
+      for (int i = 0; i < kHexTerms; ++i)
+        if (mask >> i & 1u) m = std::min(m, s[i]);
+      for (int i = 0; i < kHexTerms; ++i)
+        if (mask >> i & 1u) z[i] = std::exp(-mean_softmin * (s[i] - m)), sum += z[i];
+      if (sum > 0.0) {  // no active term: nothing to add
+        soft_value = mean_weight * (std::log(sum) / mean_softmin - m);
+        for (int i = 0; i < kLanes; ++i) soft_k[i] = -mean_weight * (z[i] / sum);
+      }
+      std::fill(std::begin(ex2), std::end(ex2), 0.0);
+    } else {
+      for (int i = 0; i < kHexTerms; ++i)
+        ex2[i] = mean_weight != 0.0 && (mask >> i & 1u) ? mean_weight * std::exp(mean_beta * (s_ref - s[i])) : 0.0;
+    }
     ex[kHexTerms] = ex2[kHexTerms] = 0.0;
     // term value; k = df/ds; the Winslow gradient's factors (k2 e_k + kd d_k, times mu)
     double value[kLanes], k[kLanes], wk2[kLanes], wkd[kLanes];
@@ -404,7 +427,7 @@ struct QualityKernel {
       double k2, kd;
       const double fw = winslow.finish((a2[i] + b2[i]) + c2[i], t.det[i], inv_c[i], inv_r[i], c23[i], k2, kd);
       value[i] = ex[i] + ex2[i] + mu * fw;
-      k[i] = -beta * ex[i] - mean_beta * ex2[i];
+      k[i] = -beta * ex[i] - mean_beta * ex2[i] + soft_k[i];
       wk2[i] = mu * k2, wkd[i] = mu * kd;
     }
     double barrier_value[kLanes] = {};  // add_barrier, lane-parallel but for the logarithm
@@ -421,7 +444,7 @@ struct QualityKernel {
       a2k[i] = wk2[i] - ks * a2[i] * b2[i];
       bk[i] = kl + wkd[i];
     }
-    double f = 0.0;
+    double f = soft_value;
     for (int i = 0; i < kHexTerms; ++i) {
       if (!(mask >> i & 1u)) continue;
       f += value[i];
