@@ -1147,9 +1147,10 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
     // still ends lower. `barrier` adds the kernel's log barrier at that floor, `mu` weighs the
     // Winslow regularizer; `softmin` > 0 makes the mean term each hex's softmin
     // (QualityKernel::mean_softmin) weighed `softmin_weight`; up to `runs` L-BFGS runs while one
-    // ends unconverged. Sets `kept` when the result stays; returns the runs made.
+    // ends unconverged (`after_delta`: see below). Sets `kept` when the result stays; returns the
+    // runs made.
     auto run_polish = [&](double barrier, double mu, double softmin, double softmin_weight,
-                          int runs, bool& kept) {
+                          int runs, bool after_delta, bool& kept) {
       if (runs <= 0 || params.max_mean_inner <= 0 || !(params.mean_weight > 0.0) ||
           !(params.mean_pin > 0.0) || !(smin > 0.0))
         return 0;
@@ -1183,7 +1184,12 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
         // Converged (the delta or gradient test), or stuck where it started: done. Out of
         // iterations, or a line search failure after some progress (0 iterations counted):
         // another run, with a fresh L-BFGS memory.
-        if ((iterations > 0 && iterations < params.max_mean_inner) || x == x_run) break;
+        // With `after_delta`, a run the delta test ended early goes on too, unless it made no
+        // more than the test's window of iterations (a stall, not a pause).
+        if (x == x_run) break;
+        if (after_delta ? iterations > 0 && iterations <= params.inner_past
+                        : iterations > 0 && iterations < params.max_mean_inner)
+          break;
       }
       kept = ns > 0 && prob.min_corner_value() >= s_now;
       if (!kept) {
@@ -1220,7 +1226,7 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
         if (pass > 0) at_pass = checkpoint();
         if (restarts) run_restarts(pass, passes);
         bool polish_kept = false;
-        run_polish(0.0, k.mu, 0.0, 0.0, 1, polish_kept);
+        run_polish(0.0, k.mu, 0.0, 0.0, 1, false, polish_kept);
         res.stats.mean_polish_kept |= polish_kept;
         if (sweeps) run_sweeps(true, false);
         prob.evaluate(x, g, k);
@@ -1242,7 +1248,7 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
         auto final_polish = [&](bool& kept) {
           return run_polish(params.final_polish_barrier, params.final_polish_regularization,
                             params.final_polish_softmin, params.final_polish_softmin_weight,
-                            params.final_polish_runs, kept);
+                            params.final_polish_runs, params.final_polish_after_delta, kept);
         };
         const Checkpoint at_passes = checkpoint();
         res.stats.final_polish_runs = final_polish(res.stats.final_polish_kept);

@@ -613,6 +613,22 @@ TEST(GeometryPipeline, SoftminFinalPolishRaisesTheMean) {
   EXPECT_EQ(b.quality.sj_count_nonpositive, 0);
 }
 
+// A final polish run the delta test ends is followed by a fresh one (final_polish_after_delta):
+// on this small cubed sphere the first run stops on the delta test, the second within its
+// window; without the rule the polish ends after the first.
+TEST(GeometryPipeline, FinalPolishGoesOnAfterTheDeltaTest) {
+  const Generated g = testing::cubed_sphere_equiangular(4);
+  MeshParams p;
+  p.untangle.final_polish_after_delta = false;
+  const auto [a, b] = mesh_with_and_without(g, p);
+  ASSERT_TRUE(a.status.ok() && b.status.ok()) << to_string(b.status);
+  EXPECT_EQ(a.untangle.final_polish_runs, 1);
+  EXPECT_EQ(b.untangle.final_polish_runs, 2);
+  EXPECT_GT(b.untangle.optimize.iterations, a.untangle.optimize.iterations);
+  EXPECT_GE(b.quality.sj_min, a.quality.sj_min - 1e-4);
+  EXPECT_EQ(b.quality.sj_count_nonpositive, 0);
+}
+
 // Restarts whose result keeps a lower minimum than the untangled points had (here a flatter
 // smoothed minimum, beta 2, with no max-min or mean sweeps to recover it) are dropped: phase 2
 // runs again without them, and its mean polish still raises the mean (before, the whole phase
