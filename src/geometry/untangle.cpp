@@ -1131,14 +1131,15 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
         ctx.report("optimize", (pass + (round + 1.0) / params.max_quality_rounds) / passes);
         // Done when a restart gains little, or gains less than restart_slow_gain in all of its
         // iterations: the sweeps and the next pass lift such a slow climb for less.
-        const bool out_of_iterations =
-            res.stats.optimize.iterations - iterations_before >= params.max_quality_inner;
-        const bool done =
-            s - smin < 1e-3 || (out_of_iterations && s - smin < params.restart_slow_gain);
-        if (out_of_iterations && s - smin >= 1e-3 && s - smin < params.restart_slow_gain)
-          res.stats.restarts_ended_slow = true;
+        const double gain = s - smin;
+        const bool slow = res.stats.optimize.iterations - iterations_before >=
+                              params.max_quality_inner && gain < params.restart_slow_gain;
         smin = std::max(smin, s);
-        if (done) break;
+        if (gain < 1e-3) break;
+        if (slow) {
+          res.stats.restarts_ended_slow = true;
+          break;
+        }
       }
     };
     // Mean polish: the restarts' objective plus a flat exponential that weighs every corner

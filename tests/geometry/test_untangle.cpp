@@ -38,6 +38,22 @@ Generated cube_with_corner_pushed_inside() {
   return g;
 }
 
+/// Expects the gradient g of kernel.hex(p, mask) to match central differences of its energy.
+template <class Kernel>
+void expect_gradient_matches_differences(const Kernel& kernel, const Vec3 (&p)[8], unsigned mask,
+                                         const Vec3 (&g)[8], double m) {
+  for (int k = 0; k < 8; ++k)
+    for (int d = 0; d < 3; ++d) {
+      const double h = 1e-6;
+      Vec3 pp[8], pm[8], dummy[8];
+      for (int i = 0; i < 8; ++i) pp[i] = pm[i] = p[i];
+      pp[k][d] += h, pm[k][d] -= h;
+      double m1 = m, m2 = m;
+      const double fd = (kernel.hex(pp, mask, dummy, m1) - kernel.hex(pm, mask, dummy, m2)) / (2 * h);
+      EXPECT_NEAR(g[k][d], fd, 1e-5 * (1.0 + std::abs(fd))) << "point " << k << " axis " << d;
+    }
+}
+
 HexComplex complex_of(const Generated& g) {
   HexComplex c;
   c.num_vertices = g.known_mesh.num_points();
@@ -248,16 +264,7 @@ TEST(GeometryUntangle, SoftminMeanTermValueAndGradient) {
     const double term = f - f_plain;  // plain has mean_weight 0: no mean term at all
     EXPECT_GE(term, -6.0 * m - 1e-9);
     EXPECT_LE(term, -6.0 * (m - std::log(n) / soft.mean_softmin) + 1e-9);
-    for (int k = 0; k < 8; ++k)
-      for (int d = 0; d < 3; ++d) {
-        const double h = 1e-6;
-        Vec3 pp[8], pm[8], dummy[8];
-        for (int i = 0; i < 8; ++i) pp[i] = pm[i] = p[i];
-        pp[k][d] += h, pm[k][d] -= h;
-        double m1 = m, m2 = m;
-        const double fd = (soft.hex(pp, mask, dummy, m1) - soft.hex(pm, mask, dummy, m2)) / (2 * h);
-        EXPECT_NEAR(g[k][d], fd, 1e-5 * (1.0 + std::abs(fd))) << "point " << k << " axis " << d;
-      }
+    expect_gradient_matches_differences(soft, p, mask, g, m);
   }
   EXPECT_GT(checked, 50);
 }
@@ -290,16 +297,7 @@ TEST(GeometryUntangle, CentreTermGradientAndVerdictMinimum) {
       double m = std::numeric_limits<double>::infinity();
       const double f = kernel.hex(p, centre, g, m);
       if (!std::isfinite(f)) return;
-      for (int k = 0; k < 8; ++k)
-        for (int d = 0; d < 3; ++d) {
-          const double h = 1e-6;
-          Vec3 pp[8], pm[8], dummy[8];
-          for (int i = 0; i < 8; ++i) pp[i] = pm[i] = p[i];
-          pp[k][d] += h, pm[k][d] -= h;
-          double m1 = m, m2 = m;
-          const double fd = (kernel.hex(pp, centre, dummy, m1) - kernel.hex(pm, centre, dummy, m2)) / (2 * h);
-          EXPECT_NEAR(g[k][d], fd, 1e-5 * (1.0 + std::abs(fd))) << "point " << k << " axis " << d;
-        }
+      expect_gradient_matches_differences(kernel, p, centre, g, m);
     };
     if (gradients) {
       SCOPED_TRACE("trial " + std::to_string(trial));
