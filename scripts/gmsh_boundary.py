@@ -1,6 +1,8 @@
 #!/usr/bin/python3
 """Extract the boundary quad surface of a gmsh all-hex mesh -> OBJ (outward oriented).
-Usage: gmsh_boundary.py IN.msh OUT.obj   prints a one-line JSON summary; exit 1 if rejected."""
+Usage: gmsh_boundary.py IN.msh OUT.obj [VOLUME_TOLERANCE]
+prints a one-line JSON summary; exit 1 if rejected. The surface's volume must match the hexes'
+within VOLUME_TOLERANCE relative (default 1e-6; curved shapes with non-planar quads need ~1e-2)."""
 import sys, json
 import numpy as np, meshio
 HF = np.array([(0,3,2,1),(4,5,6,7),(0,1,5,4),(1,2,6,5),(2,3,7,6),(3,0,4,7)])
@@ -12,7 +14,7 @@ def hexvol(P, H):
     for a,b,c,d in tets:
         v = v + np.einsum('ij,ij->i', p[:,b]-p[:,a], np.cross(p[:,c]-p[:,a], p[:,d]-p[:,a]))/6
     return v
-def main(inp, out):
+def main(inp, out, tol=1e-6):
     m = meshio.read(inp)
     types = {}
     H = []
@@ -60,7 +62,7 @@ def main(inp, out):
     # duplicate coincident points?
     info["dup_points"] = int(len(V) - len(np.unique(np.round(V, 9), axis=0)))
     ok = info["euler"] == 2 and info["edge_mult"] == [2] and info["oriented"] and info["dup_points"] == 0 \
-         and abs(info["surface_volume"] - info["hex_volume"]) < 1e-6 * max(1, info["hex_volume"])
+         and abs(info["surface_volume"] - info["hex_volume"]) < tol * max(1, info["hex_volume"])
     if not ok:
         info["reject"] = "topology/volume check failed"; print(json.dumps(info)); return 1
     with open(out, "w") as f:
@@ -68,4 +70,4 @@ def main(inp, out):
         for p in V: f.write(f"v {p[0]:.17g} {p[1]:.17g} {p[2]:.17g}\n")
         for q in F + 1: f.write(f"f {q[0]} {q[1]} {q[2]} {q[3]}\n")
     print(json.dumps(info)); return 0
-sys.exit(main(sys.argv[1], sys.argv[2]))
+sys.exit(main(sys.argv[1], sys.argv[2], *(float(a) for a in sys.argv[3:4])))

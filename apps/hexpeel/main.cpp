@@ -324,6 +324,20 @@ int main(int argc, char** argv) {
                    "(hex corners the fixed boundary makes bad), all = whole boundary, none "
                    "(default: auto)")
       ->check(CLI::IsMember({"auto", "all", "none"}))->capture_default_str();
+  mesh->add_option("--pillow-grow", params.pillow.grow,
+                   "--pillow auto: rings of face neighbours added around the forced hexes to make "
+                   "the local shrink set (0 = the forced hexes alone)")
+      ->check(CLI::Range(0, 10))->capture_default_str();
+  mesh->add_option("--pillow-whole-fraction", params.pillow.whole_fraction,
+                   "--pillow auto: pillow the whole boundary instead when the local shrink set "
+                   "holds at least this fraction of the hexes at the boundary (1 = always local)")
+      ->check(CLI::Range(0.0, 1.0))->capture_default_str();
+  mesh->add_option("--pillow-margin", params.pillow.target_margin,
+                   "inward margin (0..1, unit normals) the pillow keeps at a boundary vertex's "
+                   "copy by keeping hexes that are not forced out of the shrink set there: the "
+                   "pillow hexes' corners at the copy cannot be better than about this; 0 = only "
+                   "what a copy needs (1e-3)")
+      ->check(CLI::Range(0.0, 1.0))->capture_default_str();
   mesh->add_flag("--no-untangle", no_untangle,
                  "keep the harmonic placement: no Winslow untangling (default: untangle)");
   mesh->add_flag("--no-optimize", no_optimize,

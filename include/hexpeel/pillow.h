@@ -57,6 +57,11 @@ struct PillowParams {
   /// on cubed spheres and pillowed grids the whole layer then gives the higher minimum
   /// (csphere_n12 0.77 vs 0.51), while sparse forced corners are better served locally.
   double whole_fraction = 0.25;
+  /// Inward margin (unit normals, 0..1) a boundary vertex's copy should have over the quads the
+  /// pillow puts at it: the pillow hexes' corners at the copy cannot be better than about this
+  /// margin, so at a vertex below it hexes that are not forced are kept out of S while that
+  /// raises it (0 = only what a copy needs to exist, a margin of 1e-3).
+  double target_margin = 0.1;
   /// Pillow passes at most (values below 1 count as 1). A pass after the first pillows, locally, forced hexes the
   /// previous one had to keep out of S (at a saddle vertex), giving that vertex another copy; it
   /// is kept only when it lowers the count of forced corners and unserved vertices.

@@ -22,6 +22,7 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <tuple>
 
@@ -178,14 +179,68 @@ double inward_margin(const std::vector<BoundaryCorner>& corners, const std::vect
   return lo;
 }
 
+/// Keeps hexes that are not forced out of S at one boundary vertex (corners `cs`) while its
+/// copy's inward margin is below `target`: the fewest such hexes whose removal reaches the target
+/// (the largest margin among those, then the lowest ids), or when no set reaches it, the set
+/// giving the largest margin (the fewest hexes among those within 1e-3 of it) if that beats the
+/// present margin. The sets are enumerated (a vertex has a handful of hexes; with more than
+/// kMaxMarginCandidates candidates nothing is tried). Returns the hexes removed.
+constexpr int kMaxMarginCandidates = 10;
+int32_t raise_margin(std::vector<uint8_t>& in_s, const std::vector<BoundaryCorner>& cs,
+                     const std::vector<uint8_t>& forced, double target, std::vector<Vec3>& scratch) {
+  const double margin = inward_margin(cs, in_s, scratch);
+  if (margin >= target) return 0;
+  std::vector<int32_t> cand;
+  for (const BoundaryCorner& c : cs)
+    if (in_s[c.hex] && !forced[c.hex]) cand.push_back(c.hex);
+  std::sort(cand.begin(), cand.end());
+  cand.erase(std::unique(cand.begin(), cand.end()), cand.end());
+  const int n = static_cast<int>(cand.size());
+  if (n == 0 || n > kMaxMarginCandidates) return 0;
+  // Subsets in order of size, then of their ids' bit pattern (lowest ids first).
+  std::vector<uint32_t> subsets;
+  for (uint32_t m = 1; m < (1u << n); ++m) subsets.push_back(m);
+  std::stable_sort(subsets.begin(), subsets.end(), [](uint32_t a, uint32_t b) {
+    return std::popcount(a) < std::popcount(b);
+  });
+  uint32_t best = 0, reached = 0;
+  double best_margin = margin + 1e-3, reached_margin = target;  // a real gain: exact to 1e-3
+  int reached_size = 0;
+  for (uint32_t m : subsets) {
+    const int size = std::popcount(m);
+    if (reached && size > reached_size) break;
+    for (int i = 0; i < n; ++i)
+      if (m >> i & 1) in_s[cand[i]] = 0;
+    const double got = inward_margin(cs, in_s, scratch);
+    for (int i = 0; i < n; ++i)
+      if (m >> i & 1) in_s[cand[i]] = 1;
+    if (got >= reached_margin && (!reached || got > reached_margin)) {
+      reached = m;
+      reached_margin = got;
+      reached_size = size;
+    }
+    if (got > best_margin + 1e-3 || (best == 0 && got > best_margin)) {
+      best = m;
+      best_margin = got;
+    }
+  }
+  const uint32_t pick = reached ? reached : best;
+  for (int i = 0; i < n; ++i)
+    if (pick >> i & 1) in_s[cand[i]] = 0;
+  return std::popcount(pick);
+}
+
 /// Drops hexes from S until every boundary vertex's copy can be served (copy_can_serve). At a
 /// vertex that fails, one hex at a time leaves S: a hex that is not forced before one that is, one
 /// whose removal alone makes the rest servable first, then the one whose removal leaves the
-/// largest inward margin (the most conflicting quad), then the lowest id. Dropping only removes
-/// normals at other vertices, so one pass over the vertices suffices. Returns the hexes dropped.
+/// largest inward margin (the most conflicting quad), then the lowest id. Then, where the
+/// vertex's margin is below `target_margin` (the pillow hexes' corners at its copy cannot be
+/// better than about the margin), hexes that are not forced leave S (raise_margin; a hex kept out
+/// of S keeps its corners, so this leaves no forced corner). Dropping only removes normals at other vertices, so one pass over the
+/// vertices suffices. Returns the hexes dropped.
 int32_t fit_to_boundary(std::vector<uint8_t>& in_s,
                         const std::vector<std::vector<BoundaryCorner>>& corners,
-                        const std::vector<uint8_t>& forced) {
+                        const std::vector<uint8_t>& forced, double target_margin) {
   int32_t dropped = 0;
   std::vector<Vec3> scratch;
   for (const std::vector<BoundaryCorner>& cs : corners) {
@@ -207,6 +262,8 @@ int32_t fit_to_boundary(std::vector<uint8_t>& in_s,
       in_s[pick] = 0;  // some hex of cs is in S, or the (empty) rest would be servable
       ++dropped;
     }
+    if (cs.empty()) continue;
+    dropped += raise_margin(in_s, cs, forced, target_margin, scratch);
   }
   return dropped;
 }
@@ -325,20 +382,25 @@ bool pillow_once(const QuadSurface& surface, const HexComplex& complex,
   std::vector<uint8_t> forced_hex(nh, 0);
   for (const ForcedConfiguration& f : forced) forced_hex[f.hex] = 1;
 
-  // Pillows S after fitting it to the boundary (or as given, fit = false: the last resort).
-  auto attempt = [&](std::vector<uint8_t> in_s, bool whole, bool fit, PillowPass* res) {
-    PillowPass c;
-    c.whole = whole;
-    if (fit) c.dropped = fit_to_boundary(in_s, corners, forced_hex);
-    c.set_size = static_cast<int32_t>(std::count(in_s.begin(), in_s.end(), 1));
-    if (c.set_size == 0) return false;
-    c.complex = pillow_set(complex, in_s, nb, &c.new_hexes, &c.new_vertices);
-    if (!is_ball(c.complex)) return false;
-    c.forced_after =
-        static_cast<int32_t>(find_forced_configurations(surface, c.complex, params.forced_sj).size());
-    c.unserved = count_unserved(corners, in_s);
-    *res = std::move(c);
-    return true;
+  // Pillows S after fitting it to the boundary (or as given, fit = false: the last resort). When
+  // the fit to the target margin leaves no ball, the fit without it (margin 0) is tried.
+  auto attempt = [&](const std::vector<uint8_t>& given, bool whole, bool fit, PillowPass* res) {
+    for (double margin : {params.target_margin, 0.0}) {
+      std::vector<uint8_t> in_s = given;
+      PillowPass c;
+      c.whole = whole;
+      if (fit) c.dropped = fit_to_boundary(in_s, corners, forced_hex, margin);
+      c.set_size = static_cast<int32_t>(std::count(in_s.begin(), in_s.end(), 1));
+      if (c.set_size == 0) continue;
+      c.complex = pillow_set(complex, in_s, nb, &c.new_hexes, &c.new_vertices);
+      if (!is_ball(c.complex)) continue;
+      c.forced_after = static_cast<int32_t>(
+          find_forced_configurations(surface, c.complex, params.forced_sj).size());
+      c.unserved = count_unserved(corners, in_s);
+      *res = std::move(c);
+      return true;
+    }
+    return false;
   };
 
   bool have = false;

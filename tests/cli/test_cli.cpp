@@ -70,6 +70,9 @@ class Cli : public ::testing::Test {
 
   /// Runs the binary with `args`, stdout and stderr captured, no shell involved.
   Outcome run(std::initializer_list<std::string> args) {
+    return run(std::vector<std::string>(args));
+  }
+  Outcome run(const std::vector<std::string>& args) {
     std::vector<std::string> a{bin_};
     a.insert(a.end(), args.begin(), args.end());
     std::vector<char*> argv;
@@ -446,6 +449,39 @@ TEST_F(Cli, FinalPolishRunsOption) {
   Outcome bad = run({"mesh", in, "-o", path("c.vtk"), "--final-polish-runs", "101"});
   EXPECT_EQ(bad.exit_code, 1) << bad.err;
   EXPECT_FALSE(fs::exists(path("c.vtk")));
+}
+
+// --pillow-whole-fraction and --pillow-grow: this solid's 4 forced corners grow into a local set
+// large enough that auto pillows the whole boundary (226 new hexes); with the fraction at 1 the
+// pillow stays local, and one ring of growth pillows fewer hexes than two; both are range-checked.
+TEST_F(Cli, PillowShrinkSetOptions) {
+  const std::string in =
+      write("rvox.obj", gen::pillowed(gen::random_voxel_solid(10, 4, 12, 2), 10, 0.3).surface);
+  auto pillow_of = [&](std::vector<std::string> extra) {
+    std::vector<std::string> args{"mesh", in, "-o", path("a.vtk"), "--report", path("a.json"),
+                                  "--quiet", "--alternatives", "0", "--no-untangle"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    Outcome o = run(args);
+    EXPECT_NE(o.exit_code, 1) << o.err;  // a mesh with hexes <= 0 exits 5: fine here
+    return nlohmann::json::parse(slurp(path("a.json"))).at("pillow");
+  };
+  const auto whole = pillow_of({});
+  const auto local2 = pillow_of({"--pillow-whole-fraction", "1"});
+  const auto local1 = pillow_of({"--pillow-whole-fraction", "1", "--pillow-grow", "1"});
+  EXPECT_TRUE(whole.at("whole_boundary").get<bool>());
+  EXPECT_FALSE(local2.at("whole_boundary").get<bool>());
+  EXPECT_FALSE(local1.at("whole_boundary").get<bool>());
+  EXPECT_LT(local2.at("new_hexes").get<int>(), whole.at("new_hexes").get<int>());
+  EXPECT_LT(local1.at("new_hexes").get<int>(), local2.at("new_hexes").get<int>());
+  for (std::vector<std::string> bad_arg : {std::vector<std::string>{"--pillow-grow", "11"},
+                                           {"--pillow-whole-fraction", "1.5"},
+                                           {"--pillow-margin", "-0.1"}}) {
+    std::vector<std::string> args{"mesh", in, "-o", path("c.vtk")};
+    args.insert(args.end(), bad_arg.begin(), bad_arg.end());
+    Outcome bad = run(args);
+    EXPECT_EQ(bad.exit_code, 1) << bad.err;
+    EXPECT_FALSE(fs::exists(path("c.vtk")));
+  }
 }
 
 // --regularization: a weaker size term in the passes raises this solid's minimum (measured:
