@@ -313,6 +313,11 @@ int main(int argc, char** argv) {
                  "kremer: accept concave chords whose side region is not flat (5.4)");
   mesh->add_flag("--no-concave-waits", no_concave_waits,
                  "kremer: concave chords do not wait for enclosed non-flat chords (5.4)");
+  bool no_stuck_fill = false;
+  mesh->add_flag("--no-stuck-fill", no_stuck_fill,
+                 "when elimination gets stuck, fail (exit 3) instead of filling the surface it "
+                 "stopped at (up to 400 quads) through a pit: one layer of hexes under a few "
+                 "quads, whose inner surface is planned in turn");
   bool strict_intrusion = false;
   mesh->add_flag("--strict-intrusion", strict_intrusion,
                  "fail with invalid_intrusion (exit 3) when a concave step cannot be intruded, "
@@ -426,6 +431,7 @@ int main(int argc, char** argv) {
     if (*check) return cmd_check(in, sharp_angle, json_out);
     if (*mesh) {
       params.search = planner == "search";
+      params.terminal.enabled = !no_stuck_fill;
       params.elimination.order.side_rule = side_rule == "cost" ? SideRule::cost : SideRule::heavier;
       params.sharp_angle_deg = sharp_angle;
       params.pillow.mode = pillow == "all"    ? PillowMode::all

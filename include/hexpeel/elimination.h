@@ -5,6 +5,7 @@
 
 #include "hexpeel/context.h"
 #include "hexpeel/elimination_state.h"
+#include "hexpeel/hex_mesh.h"
 #include "hexpeel/order.h"
 #include "hexpeel/status.h"
 
@@ -35,11 +36,23 @@ struct EliminationStats {
   double time_s = 0.0;
 };
 
+/// A hex complex of a plan's final surface when that is not a cube (terminal.h): complex
+/// vertices 0..num_vertices-1, and for each final quad (in final_quads order) its face's
+/// complex vertices in the quad's corner order.
+struct TerminalFill {
+  int32_t num_vertices = 0;
+  std::vector<Hex> hexes;          ///< positive VTK hexes (final quads outward)
+  std::vector<Quad> faces;         ///< per final quad
+  bool empty() const { return hexes.empty(); }
+};
+
 struct EliminationPlan {
   Status status;                   ///< ok, stuck
   std::vector<PlanStep> steps;     ///< in elimination order
-  std::vector<int32_t> final_quads;///< the 6 surviving quad ids (when ok), ascending
+  std::vector<int32_t> final_quads;///< the surviving quad ids (when ok), ascending: a cube's 6,
+                                   ///< or the surface `terminal` fills
   std::vector<Quad> final_corners; ///< their corners (merged input vertex ids), input order
+  TerminalFill terminal;           ///< empty unless the plan ends on a filled stuck surface
   StuckReport stuck;               ///< when stuck
   EliminationStats stats;
 };

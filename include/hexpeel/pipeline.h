@@ -10,6 +10,7 @@
 #include "hexpeel/pillow.h"
 #include "hexpeel/quality.h"
 #include "hexpeel/reconstruction.h"
+#include "hexpeel/terminal.h"
 #include "hexpeel/untangle.h"
 
 #include <nlohmann/json.hpp>
@@ -22,6 +23,7 @@ struct MeshParams {
   EliminationParams elimination;  ///< its `order` rules serve the planner too
   bool search = true;             ///< plan with the search portfolio (planner.h); false = plain greedy
   PlannerParams planner;          ///< budget, seed, side rule (its `order` is taken from `elimination`)
+  TerminalParams terminal;        ///< filling the surface elimination got stuck on
   ReconstructionParams reconstruction;
   PillowParams pillow;            ///< forced configurations and pillowing, before placement
   PlacementParams placement;
@@ -64,6 +66,7 @@ struct MeshResult {
   SurfaceDiagnosis diagnosis;    ///< input checks, chords, edges
   EliminationPlan plan;          ///< when the surface was valid
   PlannerStats planner;          ///< when the planner ran
+  TerminalStats terminal;        ///< when elimination got stuck
   ReconstructionStats reconstruction;
   PillowStats pillow;
   std::vector<ForcedConfiguration> forced;  ///< found after reconstruction (before pillowing)

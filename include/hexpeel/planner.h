@@ -61,6 +61,7 @@ struct PlannerStats {
   std::string strategy;           ///< which strategy found it: greedy, window, conflict, beam, restart
   double time_s = 0.0;
   double first_plan_s = 0.0;      ///< time until the first complete plan (0 = none found)
+  double effort_s = 0.0;          ///< work done, in budget seconds (deterministic)
   bool budget_exhausted = false;
 };
 

@@ -68,6 +68,18 @@ MeshResult mesh_with_order(const SurfaceDiagnosis& diagnosis, const MeshParams& 
     ep.order = order;
     r.plan = run_elimination(state, ep, ctx);
   }
+  if (r.plan.status.code == StatusCode::stuck) {
+    // A hex complex for the surface it stopped at (terminal.h) completes the plan.
+    TerminalParams tp = params.terminal;
+    tp.sharp_angle_deg = params.sharp_angle_deg;
+    PlannerParams pp = params.planner;
+    pp.order = order;
+    r.terminal = fill_stuck_surface(state, r.plan, tp, pp, ctx);
+    if (r.terminal.filled)
+      ctx.warn("elimination got stuck on a surface of " + std::to_string(r.terminal.stuck_quads) +
+               " quads; it was filled by a pit of " + std::to_string(r.terminal.pits) +
+               " layer(s) (" + std::to_string(r.terminal.hexes) + " hexes)");
+  }
   r.timings.elimination_s = seconds_since(t);
   if (!r.plan.status.ok()) {
     plans.push_back({-1});  // no plan: matches no key
@@ -149,6 +161,8 @@ bool ran_out_of_time(const MeshResult& r, const MeshParams& params) {
 /// without running out of time. A placement that was not untangled is expected to keep inverted
 /// hexes.
 bool order_may_help(const MeshResult& r, const MeshParams& params) {
+  // A plan completed by the stuck fill after the budget ran out: the others would run out too.
+  if (r.status.ok() && r.terminal.filled && ran_out_of_time(r, params)) return false;
   if (r.status.ok()) return params.untangle.untangle && r.quality.sj_count_nonpositive > 0;
   return !ran_out_of_time(r, params) &&
          (r.status.code == StatusCode::stuck || r.status.code == StatusCode::invalid_intrusion);
@@ -330,6 +344,15 @@ nlohmann::json to_json(const MeshResult& r) {
                   {"chords_left", r.plan.stuck.chords_left},
                   {"reasons", reasons}};
   }
+  if (r.terminal.tried)
+    j["stuck_fill"] = {{"filled", r.terminal.filled},
+                       {"stuck_quads", r.terminal.stuck_quads},
+                       {"tries", r.terminal.tries},
+                       {"effort_s", r.terminal.effort_s},
+                       {"pits", r.terminal.pits},
+                       {"pit_quads", r.terminal.pit_quads},
+                       {"hexes", r.terminal.hexes},
+                       {"time_s", r.terminal.time_s}};
   if (params_used_search(r)) {
     j["planner"] = {{"plans_tried", r.planner.plans_tried},
                     {"nodes", r.planner.nodes},

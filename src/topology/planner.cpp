@@ -280,7 +280,9 @@ struct Search {
     const size_t base = path.size();
     double bump = params.conflict_bump;
     uint64_t seeder = params.seed ^ 0xc0ff1c7ull;
-    for (int64_t round = 0; !out_of_time(); ++round) {
+    const uint64_t root = hash;
+    // A dead root (every move from it proven to lead nowhere) ends the search: no plan exists.
+    for (int64_t round = 0; !out_of_time() && !dead.count(root); ++round) {
       const uint64_t noise_seed = round == 0 ? 0 : splitmix(seeder) | 1;
       if (greedy(noise_seed)) {
         record_plan("conflict");
@@ -410,6 +412,7 @@ PlannerResult run_planner(EliminationState& state, const PlannerParams& params, 
   res.stats = s.stats;
   res.stats.states_remembered = static_cast<int64_t>(s.dead.size());
   res.stats.time_s = s.elapsed();
+  res.stats.effort_s = s.effort();
 
   // Replay the chosen plan (or the deepest stuck path) on the state, recording the steps.
   const bool found = !s.best.empty() || (state.alive_chords() <= 3);

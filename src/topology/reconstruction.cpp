@@ -144,6 +144,27 @@ Status initial_hex(Builder& b, const EliminationPlan& plan) {
   return Status::success();
 }
 
+/// The start from a plan's terminal fill (a complex of its stuck final surface), checked against
+/// the final quads.
+Status terminal_start(Builder& b, const EliminationPlan& plan, int32_t surface_vertices) {
+  const TerminalFill& t = plan.terminal;
+  if (t.faces.size() != plan.final_quads.size() || plan.final_corners.size() != plan.final_quads.size())
+    return fail("terminal fill does not match the final surface");
+  for (int32_t v = 0; v < t.num_vertices; ++v) b.new_vertex(-1);
+  for (const Hex& h : t.hexes)
+    for (int32_t v : h)
+      if (v < 0 || v >= t.num_vertices) return fail("terminal fill hex with a bad vertex");
+  b.k.hexes = t.hexes;
+  for (size_t f = 0; f < t.faces.size(); ++f) {
+    b.bnd[plan.final_quads[f]] = t.faces[f];
+    b.on_bnd[plan.final_quads[f]] = 1;
+  }
+  std::vector<int32_t> final_corner_of(b.bnd.size(), -1);
+  for (size_t f = 0; f < plan.final_quads.size(); ++f) final_corner_of[plan.final_quads[f]] = static_cast<int32_t>(f);
+  return check_boundary(b, plan.final_quads, surface_vertices,
+                        [&](int32_t q) { return plan.final_corners[final_corner_of[q]]; });
+}
+
 /// Reverse of one elimination step: extrude the side-s patch.
 Status extrude(Builder& b, const PlanStep& st, int32_t step_index, int32_t& slit_count) {
   const auto& region = st.side_quads;  // sorted
@@ -410,7 +431,8 @@ ReconstructionResult run_reconstruction(const QuadSurface& surface, const Elimin
   Builder b;
   b.bnd.assign(surface.num_quads(), Quad{-1, -1, -1, -1});
   b.on_bnd.assign(surface.num_quads(), 0);
-  res.status = initial_hex(b, plan);
+  res.status = plan.terminal.empty() ? initial_hex(b, plan)
+                                      : terminal_start(b, plan, surface.num_points());
   const bool verify = params.verify_each_step && replay != nullptr &&
                       replay->steps_applied() == static_cast<int32_t>(plan.steps.size());
   std::vector<int32_t> ids;
