@@ -341,7 +341,7 @@ int main(int argc, char** argv) {
                    "inward margin (0..1, unit normals) the pillow keeps at a boundary vertex's "
                    "copy by keeping hexes that are not forced out of the shrink set there: the "
                    "pillow hexes' corners at the copy cannot be better than about this; 0 = only "
-                   "what a copy needs (1e-3)")
+                   "what a copy needs (1e-3); measured on real cuts: helps some, inverts others")
       ->check(CLI::Range(0.0, 1.0))->capture_default_str();
   mesh->add_flag("--no-untangle", no_untangle,
                  "keep the harmonic placement: no Winslow untangling (default: untangle)");

@@ -179,16 +179,34 @@ double inward_margin(const std::vector<BoundaryCorner>& corners, const std::vect
   return lo;
 }
 
-/// Keeps hexes that are not forced out of S at one boundary vertex (corners `cs`) while its
-/// copy's inward margin is below `target`: the fewest such hexes whose removal reaches the target
-/// (the largest margin among those, then the lowest ids), or when no set reaches it, the set
-/// giving the largest margin (the fewest hexes among those within 1e-3 of it) if that beats the
-/// present margin. The sets are enumerated (a vertex has a handful of hexes; with more than
+/// The smaller of the two margins at a boundary vertex once S is split there: the copy's over
+/// the quads of S's hexes, and the one left over the quads of the other hexes (which keep their
+/// own edges into the solid; taken as one direction, the cautious case); 1 for an empty side.
+double split_margin(const std::vector<BoundaryCorner>& cs, std::vector<uint8_t>& in_s,
+                    std::vector<Vec3>& scratch) {
+  const double in = inward_margin(cs, in_s, scratch);
+  scratch.clear();
+  for (const BoundaryCorner& c : cs)
+    if (!in_s[c.hex]) scratch.push_back(c.normal);
+  if (scratch.empty()) return in;
+  double lo = -1.0, hi = 1.0;
+  for (int i = 0; i < 11; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (has_inward_direction(scratch, mid) ? lo : hi) = mid;
+  }
+  return std::min(in, lo);
+}
+
+/// Keeps hexes that are not forced out of S at one boundary vertex (corners `cs`) while the split
+/// margin there (split_margin) is below `target`: the fewest such hexes whose removal reaches the
+/// target (the largest margin among those, then the lowest ids), or when no set reaches it, the
+/// set giving the largest margin (the fewest hexes among those within 1e-3 of it) if that beats
+/// the present margin. The sets are enumerated (a vertex has a handful of hexes; with more than
 /// kMaxMarginCandidates candidates nothing is tried). Returns the hexes removed.
 constexpr int kMaxMarginCandidates = 10;
 int32_t raise_margin(std::vector<uint8_t>& in_s, const std::vector<BoundaryCorner>& cs,
                      const std::vector<uint8_t>& forced, double target, std::vector<Vec3>& scratch) {
-  const double margin = inward_margin(cs, in_s, scratch);
+  const double margin = split_margin(cs, in_s, scratch);
   if (margin >= target) return 0;
   std::vector<int32_t> cand;
   for (const BoundaryCorner& c : cs)
@@ -211,7 +229,7 @@ int32_t raise_margin(std::vector<uint8_t>& in_s, const std::vector<BoundaryCorne
     if (reached && size > reached_size) break;
     for (int i = 0; i < n; ++i)
       if (m >> i & 1) in_s[cand[i]] = 0;
-    const double got = inward_margin(cs, in_s, scratch);
+    const double got = split_margin(cs, in_s, scratch);
     for (int i = 0; i < n; ++i)
       if (m >> i & 1) in_s[cand[i]] = 1;
     if (got >= reached_margin && (!reached || got > reached_margin)) {
