@@ -165,11 +165,12 @@ int32_t count_unserved(const std::vector<std::vector<BoundaryCorner>>& corners,
 
 /// The best inward margin max_d min_n (-d . n) over the pillowed quads at a vertex, within 1e-3
 /// (bisection on has_inward_direction); 1 when no quad there is pillowed.
-double inward_margin(const std::vector<BoundaryCorner>& corners, const std::vector<uint8_t>& in_s,
-                     std::vector<Vec3>& scratch) {
+/// The best margin over the quads at a vertex whose hexes have in_s[hex] == side, within 1e-3.
+double side_margin(const std::vector<BoundaryCorner>& corners, const std::vector<uint8_t>& in_s,
+                   uint8_t side, std::vector<Vec3>& scratch) {
   scratch.clear();
   for (const BoundaryCorner& c : corners)
-    if (in_s[c.hex]) scratch.push_back(c.normal);
+    if (in_s[c.hex] == side) scratch.push_back(c.normal);
   if (scratch.empty()) return 1.0;
   double lo = -1.0, hi = 1.0;
   for (int i = 0; i < 11; ++i) {
@@ -178,23 +179,17 @@ double inward_margin(const std::vector<BoundaryCorner>& corners, const std::vect
   }
   return lo;
 }
+double inward_margin(const std::vector<BoundaryCorner>& corners, const std::vector<uint8_t>& in_s,
+                     std::vector<Vec3>& scratch) {
+  return side_margin(corners, in_s, 1, scratch);
+}
 
 /// The smaller of the two margins at a boundary vertex once S is split there: the copy's over
 /// the quads of S's hexes, and the one left over the quads of the other hexes (which keep their
 /// own edges into the solid; taken as one direction, the cautious case); 1 for an empty side.
-double split_margin(const std::vector<BoundaryCorner>& cs, std::vector<uint8_t>& in_s,
+double split_margin(const std::vector<BoundaryCorner>& cs, const std::vector<uint8_t>& in_s,
                     std::vector<Vec3>& scratch) {
-  const double in = inward_margin(cs, in_s, scratch);
-  scratch.clear();
-  for (const BoundaryCorner& c : cs)
-    if (!in_s[c.hex]) scratch.push_back(c.normal);
-  if (scratch.empty()) return in;
-  double lo = -1.0, hi = 1.0;
-  for (int i = 0; i < 11; ++i) {
-    const double mid = 0.5 * (lo + hi);
-    (has_inward_direction(scratch, mid) ? lo : hi) = mid;
-  }
-  return std::min(in, lo);
+  return std::min(side_margin(cs, in_s, 1, scratch), side_margin(cs, in_s, 0, scratch));
 }
 
 /// Keeps hexes that are not forced out of S at one boundary vertex (corners `cs`) while the split
