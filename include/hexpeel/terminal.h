@@ -29,7 +29,7 @@ struct TerminalParams {
   /// Largest stuck surface (quads) a fill is tried on; larger ones stay stuck (> 0).
   int32_t max_quads = 400;
   /// Pits (discs F) tried at most on one stuck surface, over all depths (> 0).
-  int32_t max_tries = 300;
+  int32_t max_tries = 3000;
   /// Nested fills at most: a pit surface that gets stuck is filled in turn (>= 1).
   int32_t depth = 1;
   /// Planning budget of each pit surface, in the planner's budget seconds (> 0).
