@@ -201,6 +201,7 @@ double split_margin(const std::vector<BoundaryCorner>& cs, const std::vector<uin
 constexpr int kMaxMarginCandidates = 10;
 int32_t raise_margin(std::vector<uint8_t>& in_s, const std::vector<BoundaryCorner>& cs,
                      const std::vector<uint8_t>& forced, double target, std::vector<Vec3>& scratch) {
+  if (target <= 0) return 0;  // the copy's margin is > 0 already (copy_can_serve)
   const double margin = split_margin(cs, in_s, scratch);
   if (margin >= target) return 0;
   std::vector<int32_t> cand;
@@ -398,7 +399,9 @@ bool pillow_once(const QuadSurface& surface, const HexComplex& complex,
   // Pillows S after fitting it to the boundary (or as given, fit = false: the last resort). When
   // the fit to the target margin leaves no ball, the fit without it (margin 0) is tried.
   auto attempt = [&](const std::vector<uint8_t>& given, bool whole, bool fit, PillowPass* res) {
-    for (double margin : {params.target_margin, 0.0}) {
+    const int fits = fit && params.target_margin > 0 ? 2 : 1;
+    for (int f = 0; f < fits; ++f) {
+      const double margin = f == 0 ? params.target_margin : 0.0;
       std::vector<uint8_t> in_s = given;
       PillowPass c;
       c.whole = whole;

@@ -156,6 +156,10 @@ Status terminal_start(Builder& b, const EliminationPlan& plan, int32_t surface_v
       if (v < 0 || v >= t.num_vertices) return fail("terminal fill hex with a bad vertex");
   b.k.hexes = t.hexes;
   for (size_t f = 0; f < t.faces.size(); ++f) {
+    const int32_t q = plan.final_quads[f];
+    if (q < 0 || q >= static_cast<int32_t>(b.bnd.size())) return fail("terminal fill names a bad quad");
+    for (int32_t v : t.faces[f])
+      if (v < 0 || v >= t.num_vertices) return fail("terminal fill face with a bad vertex");
     b.bnd[plan.final_quads[f]] = t.faces[f];
     b.on_bnd[plan.final_quads[f]] = 1;
   }

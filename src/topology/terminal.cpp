@@ -6,7 +6,7 @@
 // wall quad (a, b, b', a'). The layer hexes (f' below, f above: bottom = f' in VTK order) glue
 // onto P's complex along F' and the walls and leave S as the boundary. Discs are ranked by how
 // many edges of P join two vertices of valence 3 (each blocks the chord across it), fewest first,
-// then by size and quad ids.
+// then by the discs' sorted quad ids.
 #include "hexpeel/terminal.h"
 
 #include "hexpeel/chords.h"
