@@ -321,12 +321,6 @@ HexComplex pillow_set(const HexComplex& c, const std::vector<uint8_t>& in_s,
   return out;
 }
 
-bool is_ball(const HexComplex& c) {
-  HexMesh m;
-  m.points.assign(c.num_vertices, Vec3::Zero());
-  m.hexes = c.hexes;
-  return quality_detail::analyze_topology(m).is_ball;
-}
 
 }  // namespace
 
@@ -409,7 +403,7 @@ bool pillow_once(const QuadSurface& surface, const HexComplex& complex,
       c.set_size = static_cast<int32_t>(std::count(in_s.begin(), in_s.end(), 1));
       if (c.set_size == 0) continue;
       c.complex = pillow_set(complex, in_s, nb, &c.new_hexes, &c.new_vertices);
-      if (!is_ball(c.complex)) continue;
+      if (!quality_detail::is_ball(c.complex.num_vertices, c.complex.hexes)) continue;
       c.forced_after = static_cast<int32_t>(
           find_forced_configurations(surface, c.complex, params.forced_sj).size());
       c.unserved = count_unserved(corners, in_s);

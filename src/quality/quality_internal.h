@@ -39,6 +39,14 @@ struct ComplexTopology {
 /// connected with Euler characteristic 2; the complex's Euler characteristic 1.
 ComplexTopology analyze_topology(const HexMesh& mesh);
 
+/// Whether hexes over vertices 0..num_vertices-1 form a ball (analyze_topology, positions unused).
+inline bool is_ball(int32_t num_vertices, const std::vector<Hex>& hexes) {
+  HexMesh m;
+  m.points.assign(num_vertices, Vec3::Zero());
+  m.hexes = hexes;
+  return analyze_topology(m).is_ball;
+}
+
 struct BoundaryMatch {
   bool matches = false;
   std::string message;  ///< the first difference found, empty when matching

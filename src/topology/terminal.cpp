@@ -319,10 +319,7 @@ bool fill_with_pit(const QuadSurface& s, const Pit& pit, const TerminalParams& p
   // A fold the pillow above did not undo (at a corner of F, a pillowed hex's pillow still meets
   // the layer hex around the corner's vertex on s, whose link then pinches), or any other defect:
   // no ball, so try the next pit.
-  HexMesh check;
-  check.points.assign(t.num_vertices, Vec3::Zero());
-  check.hexes = t.hexes;
-  if (!quality_detail::analyze_topology(check).is_ball) return false;
+  if (!quality_detail::is_ball(t.num_vertices, t.hexes)) return false;
   out.pits = 1 + nested_pits;
   out.pit_quads = static_cast<int32_t>(pit.disc.size());
   return true;
