@@ -40,6 +40,13 @@ std::vector<int64_t> plan_key(const EliminationPlan& plan) {
   key.reserve(plan.steps.size());
   for (const PlanStep& s : plan.steps)
     key.push_back(static_cast<int64_t>(s.chord) * 4 + s.side * 2 + (s.concave ? 1 : 0));
+  // A stuck fill depends on the order's rules too: the same steps with another fill are
+  // another plan. -1 cannot be a step's key.
+  if (!plan.terminal.empty()) {
+    key.push_back(-1);
+    key.push_back(plan.terminal.num_vertices);
+    for (const Hex& h : plan.terminal.hexes) key.insert(key.end(), h.begin(), h.end());
+  }
   return key;
 }
 

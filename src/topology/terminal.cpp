@@ -122,18 +122,14 @@ Pit dig(const QuadSurface& s, const std::vector<int32_t>& nb, const std::vector<
         p.layer_of.push_back(slot);
       }
   }
+  // On a closed manifold surface a vertex has as many edges as quads; every edge lies in two
+  // quads, so each blocking edge is seen twice.
   std::vector<int32_t> valence(p.surface.num_points(), 0);
-  std::set<std::pair<int32_t, int32_t>> edges;
   for (const Quad& t : p.surface.quads)
-    for (int k = 0; k < 4; ++k) {
-      const int32_t a = t[k], b = t[(k + 1) & 3];
-      if (a < b) {
-        edges.insert({a, b});
-        ++valence[a];
-        ++valence[b];
-      }
-    }
-  for (const auto& [a, b] : edges) p.blocking += valence[a] == 3 && valence[b] == 3;
+    for (int32_t v : t) ++valence[v];
+  for (const Quad& t : p.surface.quads)
+    for (int k = 0; k < 4; ++k) p.blocking += valence[t[k]] == 3 && valence[t[(k + 1) & 3]] == 3;
+  p.blocking /= 2;
   return p;
 }
 
@@ -191,9 +187,14 @@ std::vector<int32_t> folding_hexes(const HexComplex& k, const Pit& pit) {
   return out;
 }
 
+struct Candidate {
+  int32_t blocking = 0;       ///< Pit::blocking of its pit
+  std::vector<int32_t> disc;  ///< sorted quad ids
+};
+
 /// Discs tried on S, best first: edge-connected sets of 2 or 3 quads and the stars of vertices
 /// (a single quad's pit always gives 4 copies of valence 3 joined in a ring, so it is left out).
-std::vector<Pit> candidate_pits(const QuadSurface& s, const std::vector<int32_t>& nb) {
+std::vector<Candidate> candidate_pits(const QuadSurface& s, const std::vector<int32_t>& nb) {
   std::set<std::vector<int32_t>> discs;
   for (int32_t q = 0; q < s.num_quads(); ++q)
     for (int k = 0; k < 4; ++k) {
@@ -217,14 +218,16 @@ std::vector<Pit> candidate_pits(const QuadSurface& s, const std::vector<int32_t>
     st.erase(std::unique(st.begin(), st.end()), st.end());
     if (st.size() > 1) discs.insert(st);
   }
-  std::vector<Pit> pits;
+  // Only the rank is kept: the pit surfaces are dug again when tried, so that a fill that
+  // succeeds early never holds thousands of them.
+  std::vector<Candidate> out;
   for (const std::vector<int32_t>& f : discs)
     if (f.size() + 2 <= static_cast<size_t>(s.num_quads()) && is_disc(s, nb, f))
-      pits.push_back(dig(s, nb, f));
-  std::stable_sort(pits.begin(), pits.end(), [](const Pit& a, const Pit& b) {
+      out.push_back({dig(s, nb, f).blocking, f});
+  std::sort(out.begin(), out.end(), [](const Candidate& a, const Candidate& b) {
     return std::tie(a.blocking, a.disc) < std::tie(b.blocking, b.disc);
   });
-  return pits;
+  return out;
 }
 
 /// What is left of the fill's budget: pits to try and planning work (budget seconds).
@@ -330,10 +333,10 @@ bool fill_surface(const QuadSurface& s, const TerminalParams& params, const Plan
   const std::vector<int32_t> nb = across(s);
   for (int32_t x : nb)
     if (x < 0) return false;
-  for (const Pit& pit : candidate_pits(s, nb)) {
+  for (const Candidate& c : candidate_pits(s, nb)) {
     if (!budget.left()) return false;
     --budget.tries;
-    if (fill_with_pit(s, pit, params, planner, depth, budget, out)) return true;
+    if (fill_with_pit(s, dig(s, nb, c.disc), params, planner, depth, budget, out)) return true;
   }
   return false;
 }
