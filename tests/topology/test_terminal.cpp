@@ -18,33 +18,33 @@ namespace {
 
 /// 20 quads, 22 vertices, 6 chords, none of which can be eliminated (collapsing any would leave
 /// a vertex of valence 2 or an edge with other than two quads): the surface a real surface's
-/// elimination stopped at (a genus-0 cut of a published hex mesh), with its vertices moved onto
-/// the unit sphere.
+/// elimination stopped at (a genus-0 cut of a published hex mesh), its vertices embedded on the
+/// unit sphere (graph Laplacian eigenvectors, then spherical Laplacian smoothing).
 QuadSurface stuck_surface() {
   QuadSurface s;
   s.points = {
-      {0.169790, -0.252678, -0.952536},
-      {0.182906, -0.254652, -0.949578},
-      {0.180238, -0.254812, -0.950045},
-      {0.167865, -0.252946, -0.952806},
-      {0.137879, -0.248284, -0.958825},
-      {0.107763, -0.243377, -0.963927},
-      {0.106042, -0.242530, -0.964331},
-      {0.137990, -0.247738, -0.958950},
-      {0.138097, -0.247204, -0.959072},
-      {0.107981, -0.242298, -0.964174},
-      {0.095258, -0.241281, -0.965769},
-      {0.092775, -0.240303, -0.966254},
-      {0.095475, -0.240204, -0.966016},
-      {0.137986, -0.247750, -0.958947},
-      {0.106038, -0.242543, -0.964328},
-      {0.107760, -0.243384, -0.963925},
-      {0.107978, -0.242306, -0.964173},
-      {0.167864, -0.252954, -0.952804},
-      {0.169787, -0.252691, -0.952533},
-      {0.168085, -0.251865, -0.953054},
-      {0.180457, -0.253730, -0.950293},
-      {0.168083, -0.251873, -0.953052}};
+      {-0.873962, 0.045922, 0.483819},
+      {-0.999975, 0.000979, -0.007019},
+      {-0.898376, -0.437906, 0.034059},
+      {-0.760277, -0.594770, 0.261206},
+      {-0.001618, -0.995795, 0.091594},
+      {0.755369, -0.596254, 0.271844},
+      {0.867173, 0.044217, 0.496040},
+      {-0.006899, 0.091603, 0.995772},
+      {0.001618, 0.995795, -0.091594},
+      {0.757367, 0.633401, 0.158739},
+      {0.896950, -0.439664, 0.046660},
+      {0.999975, -0.000979, 0.007019},
+      {0.898376, 0.437906, -0.034059},
+      {0.006899, -0.091603, -0.995772},
+      {0.873962, -0.045922, -0.483819},
+      {0.758278, -0.634886, -0.148101},
+      {0.760277, 0.594770, -0.261206},
+      {-0.757367, -0.633401, -0.158739},
+      {-0.867173, -0.044217, -0.496040},
+      {-0.758278, 0.634886, 0.148101},
+      {-0.896950, 0.439664, -0.046660},
+      {-0.755369, 0.596254, -0.271844}};
   s.quads = {{0, 1, 2, 3}, {4, 5, 6, 7}, {8, 7, 6, 9}, {6, 5, 10, 11}, {9, 6, 11, 12}, {4, 13, 14, 15}, {15, 10, 5, 4}, {16, 14, 13, 8}, {9, 12, 16, 8}, {12, 11, 14, 16}, {14, 11, 10, 15}, {4, 3, 2, 17}, {18, 13, 4, 17}, {0, 19, 20, 1}, {8, 13, 18, 21}, {19, 8, 21, 20}, {17, 2, 1, 18}, {21, 18, 1, 20}, {7, 0, 3, 4}, {19, 0, 7, 8}};
   return s;
 }
@@ -95,9 +95,9 @@ TEST(Terminal, StuckSurfaceIsFilledThroughAPit) {
   EXPECT_EQ(plan2.terminal.hexes, plan.terminal.hexes);
 }
 
-// Through the pipeline: a mesh that is a ball with the surface as its boundary (its hexes are
-// not all positive on this small, folded shape: the figures are the pipeline's business), and
-// without the fill the run fails as stuck.
+// Through the pipeline: a mesh that is a ball with the surface as its boundary and no inverted
+// hex (26 hexes, min scaled Jacobian 0.226 when written), and without the fill the run fails as
+// stuck.
 TEST(Terminal, PipelineMeshesAStuckSurface) {
   const PolygonSoup soup = to_polygon_soup(stuck_surface());
   MeshParams mp;
@@ -107,6 +107,8 @@ TEST(Terminal, PipelineMeshesAStuckSurface) {
   EXPECT_TRUE(r.terminal.filled);
   EXPECT_TRUE(r.quality.is_ball) << r.quality.topology_message;
   EXPECT_EQ(r.quality.boundary_matches_surface, true) << r.quality.boundary_message;
+  EXPECT_EQ(r.quality.sj_count_nonpositive, 0);
+  EXPECT_GT(r.quality.sj_min, 0.1);
   EXPECT_TRUE(to_json(r).contains("stuck_fill"));
   mp.terminal.enabled = false;
   MeshResult off = run_mesh(soup, mp);
