@@ -34,6 +34,7 @@ struct EliminationStats {
   int64_t predicted_hexes = 0;     ///< 1 + sum of |side|
   int32_t feasibility_tests = 0;
   double time_s = 0.0;
+  bool timed_out = false;          ///< stopped (status stuck) by EliminationParams::time_limit_s
 };
 
 /// A hex complex of a plan's final surface when that is not a cube (terminal.h): complex

@@ -75,8 +75,10 @@ MeshResult mesh_with_order(const SurfaceDiagnosis& diagnosis, const MeshParams& 
     ep.order = order;
     r.plan = run_elimination(state, ep, ctx);
   }
-  if (r.plan.status.code == StatusCode::stuck) {
-    // A hex complex for the surface it stopped at (terminal.h) completes the plan.
+  if (r.plan.status.code == StatusCode::stuck && !r.plan.stats.timed_out) {
+    // A hex complex for the surface it stopped at (terminal.h) completes the plan; not when
+    // greedy elimination was stopped by --time-limit (that surface is not stuck, and the user
+    // asked to give up).
     TerminalParams tp = params.terminal;
     tp.sharp_angle_deg = params.sharp_angle_deg;
     PlannerParams pp = params.planner;
@@ -158,9 +160,7 @@ MeshResult mesh_with_order(const SurfaceDiagnosis& diagnosis, const MeshParams& 
 /// Whether r's order ran out of its time (the planner's budget, greedy's time limit): that ends
 /// the tries, the limit is the user's.
 bool ran_out_of_time(const MeshResult& r, const MeshParams& params) {
-  return params.search ? r.planner.budget_exhausted
-                       : params.elimination.time_limit_s > 0 &&
-                             r.timings.elimination_s >= params.elimination.time_limit_s;
+  return params.search ? r.planner.budget_exhausted : r.plan.stats.timed_out;
 }
 
 /// Whether another elimination order may do better than r: its untangled mesh keeps hexes with

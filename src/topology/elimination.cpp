@@ -67,6 +67,7 @@ EliminationPlan run_elimination(EliminationState& state, const EliminationParams
     if (params.time_limit_s > 0 &&
         std::chrono::duration<double>(clock::now() - t0).count() > params.time_limit_s) {
       plan.status = Status::error(StatusCode::stuck, "time limit reached during elimination");
+      plan.stats.timed_out = true;
       break;
     }
     // Min-heap on (key, is_full): a chord's full key is never smaller than its quick key.

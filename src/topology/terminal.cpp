@@ -4,7 +4,8 @@
 // a little inside; P = S without F, plus F's quads on the copies (same corner order, so still
 // outward: they face the pit's mouth), plus for every rim edge a->b of F (in F's orientation) the
 // wall quad (a, b, b', a'). The layer hexes (f' below, f above: bottom = f' in VTK order) glue
-// onto P's complex along F' and the walls and leave S as the boundary. Discs are ranked by how
+// onto P's complex (pillowed whole first, see pillow_whole) along F' and the walls and leave S
+// as the boundary. Discs are ranked by how
 // many edges of P join two vertices of valence 3 (each blocks the chord across it), fewest first,
 // then by the discs' sorted quad ids.
 #include "hexpeel/terminal.h"
@@ -70,8 +71,6 @@ struct Pit {
   QuadSurface surface;
   std::vector<int32_t> origin;
   std::vector<int32_t> disc;
-  std::vector<int32_t> layer_of;  ///< per P quad: the disc quad (index in disc) whose layer hex
-                                  ///< it will touch (floor or wall), -1 for S's other quads
   int32_t blocking = 0;  ///< edges of P between two valence-3 vertices
 };
 
@@ -109,18 +108,14 @@ Pit dig(const QuadSurface& s, const std::vector<int32_t>& nb, const std::vector<
     const Quad& t = s.quads[q];
     if (!in_f(q)) {
       p.surface.quads.push_back({keep[t[0]], keep[t[1]], keep[t[2]], keep[t[3]]});
-      p.layer_of.push_back(-1);
       continue;
     }
-    const int32_t slot = static_cast<int32_t>(std::lower_bound(f.begin(), f.end(), q) - f.begin());
     p.surface.quads.push_back({copy[t[0]], copy[t[1]], copy[t[2]], copy[t[3]]});
-    p.layer_of.push_back(slot);
     for (int k = 0; k < 4; ++k)
       if (!in_f(nb[4 * q + k])) {
         const int32_t a = t[k], b = t[(k + 1) & 3];
         p.surface.quads.push_back({keep[a], keep[b], copy[b], copy[a]});
-        p.layer_of.push_back(slot);
-      }
+          }
   }
   // On a closed manifold surface a vertex has as many edges as quads; every edge lies in two
   // quads, so each blocking edge is seen twice.
@@ -133,58 +128,45 @@ Pit dig(const QuadSurface& s, const std::vector<int32_t>& nb, const std::vector<
   return p;
 }
 
-/// Pillows hex h of `k` alone: h moves onto copies of its 8 vertices and each of its faces gets a
-/// hex between the face and its copy (Mitchell & Tautges' pillow of the shrink set {h}). The
-/// boundary stays; h's corners there get an interior edge each.
-void pillow_hex(HexComplex& k, int32_t h) {
-  const Hex old = k.hexes[h];
-  Hex copy;
-  for (int i = 0; i < 8; ++i) {
-    copy[i] = k.num_vertices++;
-    k.input_vertex.push_back(-1);
-    k.created_at.push_back(-1);
-  }
-  k.hexes[h] = copy;
-  for (const auto& lf : kHexFaces) {  // faces seen from outside h
-    Hex n;
-    for (int i = 0; i < 4; ++i) {
-      n[i] = copy[lf[i]];
-      n[i + 4] = old[lf[i]];
+/// Pillows the whole of `k` (the pit surface's complex): every boundary vertex gets a copy that
+/// the hexes move onto, and every boundary face a hex between it and its copy (Mitchell &
+/// Tautges' pillow with all of k as the shrink set). The boundary stays. Gluing the pit layer
+/// onto k directly fails whenever a hex of k has a face that spans two edges of a layer hex at
+/// a rim vertex (at a corner of the disc, a hex holding both of the corner's walls): the union
+/// is then pinched there, which pillowing that hex alone does not undo. After the whole pillow,
+/// the only hexes at the pit's vertices are pillow hexes, each on one face of P, and the layer
+/// meets k exactly in the floor and the walls.
+void pillow_whole(HexComplex& k) {
+  std::map<std::array<int32_t, 4>, int32_t> uses;  // sorted face -> hexes using it
+  auto key = [&](const Hex& h, const std::array<int, 4>& lf) {
+    std::array<int32_t, 4> f{h[lf[0]], h[lf[1]], h[lf[2]], h[lf[3]]};
+    std::sort(f.begin(), f.end());
+    return f;
+  };
+  for (const Hex& h : k.hexes)
+    for (const auto& lf : kHexFaces) ++uses[key(h, lf)];
+  std::vector<int32_t> copy(k.num_vertices, -1);
+  for (int32_t v = 0; v < static_cast<int32_t>(copy.size()); ++v)
+    if (k.input_vertex[v] >= 0) {
+      copy[v] = k.num_vertices++;
+      k.input_vertex.push_back(-1);
+      k.created_at.push_back(-1);
     }
-    k.hexes.push_back(n);
+  const size_t n = k.hexes.size();
+  for (size_t i = 0; i < n; ++i) {
+    const Hex old = k.hexes[i];
+    for (const auto& lf : kHexFaces)  // faces seen from outside the hex
+      if (uses[key(old, lf)] == 1) {
+        Hex p;
+        for (int j = 0; j < 4; ++j) {
+          p[j] = copy[old[lf[j]]];
+          p[j + 4] = old[lf[j]];
+        }
+        k.hexes.push_back(p);
+      }
+    for (int32_t& v : k.hexes[i])
+      if (copy[v] >= 0) v = copy[v];
   }
-}
-
-/// Hexes of P's complex `k` with two or more faces that one layer hex will be glued to (its floor
-/// and a wall, or two walls): glued, they would share two faces (a doublet edge, never a good
-/// hex) or three (a corner of F: the two hexes' common corner on S gets a pinched link).
-std::vector<int32_t> folding_hexes(const HexComplex& k, const Pit& pit) {
-  const QuadSurface& ps = pit.surface;
-  std::vector<int32_t> pc_of_p(ps.num_points(), -1);
-  for (int32_t v = 0; v < k.num_vertices; ++v)
-    if (k.input_vertex[v] >= 0) pc_of_p[k.input_vertex[v]] = v;
-  std::map<std::array<int32_t, 4>, int32_t> layer_face;  // sorted complex vertices -> disc slot
-  for (int32_t q = 0; q < ps.num_quads(); ++q)
-    if (pit.layer_of[q] >= 0) {
-      std::array<int32_t, 4> key;
-      for (int i = 0; i < 4; ++i) key[i] = pc_of_p[ps.quads[q][i]];
-      std::sort(key.begin(), key.end());
-      layer_face[key] = pit.layer_of[q];
-    }
-  std::vector<int32_t> out;
-  for (int32_t h = 0; h < static_cast<int32_t>(k.hexes.size()); ++h) {
-    std::vector<int32_t> slots;
-    for (const auto& lf : kHexFaces) {
-      std::array<int32_t, 4> key;
-      for (int i = 0; i < 4; ++i) key[i] = k.hexes[h][lf[i]];
-      std::sort(key.begin(), key.end());
-      const auto it = layer_face.find(key);
-      if (it != layer_face.end()) slots.push_back(it->second);
-    }
-    std::sort(slots.begin(), slots.end());
-    if (std::adjacent_find(slots.begin(), slots.end()) != slots.end()) out.push_back(h);
-  }
-  return out;
 }
 
 struct Candidate {
@@ -247,9 +229,12 @@ struct Fill {
 bool fill_surface(const QuadSurface& s, const TerminalParams& params, const PlannerParams& planner,
                   int depth, Budget& budget, Fill& out);
 
-/// Plans and reconstructs the pit surface; on success its complex with the layer, in s's numbering.
+/// Plans and reconstructs the pit surface; on success its complex with the layer, in s's
+/// numbering. When the pit surface gets stuck, `stuck_quads` is the size of the surface it
+/// stopped at, and with `nest` (and depth > 1) that surface is filled in turn.
 bool fill_with_pit(const QuadSurface& s, const Pit& pit, const TerminalParams& params,
-                   const PlannerParams& planner, int depth, Budget& budget, Fill& out) {
+                   const PlannerParams& planner, int depth, bool nest, Budget& budget, Fill& out,
+                   int32_t& stuck_quads) {
   const QuadSurface& ps = pit.surface;
   const QuadAdjacency adj = build_adjacency(ps);
   for (int32_t o : adj.opposite)
@@ -263,9 +248,12 @@ bool fill_with_pit(const QuadSurface& s, const Pit& pit, const TerminalParams& p
   pp.budget_s = std::min(params.budget_s, budget.effort);
   pp.improve_budget_s = std::min(pp.improve_budget_s, 0.2 * pp.budget_s);
   PlannerResult pr = run_planner(state, pp);
-  budget.effort -= pr.stats.effort_s;
+  // The digging, chord and edge set-up of a try count too (about 1 us per quad), so that tens
+  // of thousands of tries of large pit surfaces stay within the budget.
+  budget.effort -= pr.stats.effort_s + 1e-6 * ps.num_quads();
   int32_t nested_pits = 0;
-  if (pr.plan.status.code == StatusCode::stuck && depth > 1 && budget.left()) {
+  stuck_quads = pr.plan.status.code == StatusCode::stuck ? state.alive_quads() : -1;
+  if (stuck_quads >= 0 && nest && depth > 1 && budget.left()) {
     std::vector<int32_t> ids;
     const QuadSurface inner = state.current_surface(&ids);
     Fill nested;
@@ -285,7 +273,7 @@ bool fill_with_pit(const QuadSurface& s, const Pit& pit, const TerminalParams& p
   ReconstructionResult rec = run_reconstruction(ps, pr.plan, rp, {}, &state);
   if (!rec.status.ok()) return false;
   HexComplex& k = rec.complex;
-  for (int32_t h : folding_hexes(k, pit)) pillow_hex(k, h);
+  pillow_whole(k);
   // Complex vertices: s's vertices first (those on P from P's complex, F's inner ones new), then
   // P's complex's interior vertices.
   const int32_t ns = s.num_points();
@@ -319,9 +307,7 @@ bool fill_with_pit(const QuadSurface& s, const Pit& pit, const TerminalParams& p
     t.hexes.push_back(h);
   }
   for (const Quad& f : s.quads) t.faces.push_back(f);  // s's vertices keep their numbers
-  // A fold the pillow above did not undo (at a corner of F, a pillowed hex's pillow still meets
-  // the layer hex around the corner's vertex on s, whose link then pinches), or any other defect:
-  // no ball, so try the next pit.
+  // Any defect left: no ball, so try the next pit.
   if (!quality_detail::is_ball(t.num_vertices, t.hexes)) return false;
   out.pits = 1 + nested_pits;
   out.pit_quads = static_cast<int32_t>(pit.disc.size());
@@ -333,10 +319,31 @@ bool fill_surface(const QuadSurface& s, const TerminalParams& params, const Plan
   const std::vector<int32_t> nb = across(s);
   for (int32_t x : nb)
     if (x < 0) return false;
-  for (const Candidate& c : candidate_pits(s, nb)) {
+  // Every pit first on its own; then, deeper, the pits whose surfaces got furthest (stopped at
+  // the fewest quads, fewer than s has) have the surfaces they stopped at filled in turn,
+  // furthest first. One pit rarely unblocks every chord of a large stuck surface, but it often
+  // lets elimination go on to a smaller one.
+  const std::vector<Candidate> cands = candidate_pits(s, nb);
+  std::vector<std::pair<int32_t, size_t>> progress;  // (stuck quads, candidate)
+  for (size_t i = 0; i < cands.size(); ++i) {
     if (!budget.left()) return false;
     --budget.tries;
-    if (fill_with_pit(s, dig(s, nb, c.disc), params, planner, depth, budget, out)) return true;
+    int32_t stuck_quads = -1;
+    if (fill_with_pit(s, dig(s, nb, cands[i].disc), params, planner, depth, false, budget, out,
+                      stuck_quads))
+      return true;
+    if (stuck_quads >= 0 && stuck_quads < s.num_quads()) progress.emplace_back(stuck_quads, i);
+  }
+  if (depth <= 1) return false;
+  std::sort(progress.begin(), progress.end());
+  if (progress.size() > static_cast<size_t>(params.descend)) progress.resize(params.descend);
+  for (const auto& [stuck_quads, i] : progress) {
+    if (!budget.left()) return false;
+    --budget.tries;
+    int32_t again = -1;
+    if (fill_with_pit(s, dig(s, nb, cands[i].disc), params, planner, depth, true, budget, out,
+                      again))
+      return true;
   }
   return false;
 }
