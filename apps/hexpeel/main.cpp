@@ -316,8 +316,16 @@ int main(int argc, char** argv) {
   bool no_stuck_fill = false;
   mesh->add_flag("--no-stuck-fill", no_stuck_fill,
                  "when elimination gets stuck, fail (exit 3) instead of filling the surface it "
-                 "stopped at (up to 400 quads) through a pit: one layer of hexes under a few "
-                 "quads, whose inner surface is planned in turn");
+                 "stopped at (up to --stuck-fill-quads quads) through a pit: one layer of hexes "
+                 "under a few quads, whose inner surface is planned in turn");
+  mesh->add_option("--stuck-fill-quads", params.terminal.max_quads,
+                   "largest stuck surface (quads) the stuck fill is tried on; larger ones fail "
+                   "as stuck (exit 3)")
+      ->check(CLI::Range(1, 1000000))->capture_default_str();
+  mesh->add_option("--stuck-fill-budget", params.terminal.total_budget_s,
+                   "planning budget of the whole stuck fill, all pits and depths, in budget "
+                   "seconds (see --plan-budget)")
+      ->check(CLI::PositiveNumber)->capture_default_str();
   bool strict_intrusion = false;
   mesh->add_flag("--strict-intrusion", strict_intrusion,
                  "fail with invalid_intrusion (exit 3) when a concave step cannot be intruded, "

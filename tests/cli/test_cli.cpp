@@ -484,6 +484,30 @@ TEST_F(Cli, PillowShrinkSetOptions) {
   }
 }
 
+// The stuck fill's options: the 20-quad surface no chord can leave is filled by default, fails
+// as stuck (exit 3, nothing written) when the fill may not take surfaces that large, and the
+// options are range-checked.
+TEST_F(Cli, StuckFillOptions) {
+  const std::string in = write("stuck.obj", gen::stuck_surface());
+  const Outcome filled = run({"mesh", in, "-o", path("f.vtk"), "--report", path("f.json"), "-q"});
+  EXPECT_EQ(filled.exit_code, 0) << filled.err;
+  const auto fill = nlohmann::json::parse(slurp(path("f.json"))).at("stuck_fill");
+  EXPECT_TRUE(fill.at("filled").get<bool>());
+  EXPECT_EQ(fill.at("stuck_quads").get<int>(), 20);
+  const Outcome small = run({"mesh", in, "-o", path("s.vtk"), "--stuck-fill-quads", "19", "-q"});
+  EXPECT_EQ(small.exit_code, 3) << small.err;
+  EXPECT_NE(small.err.find("stuck"), std::string::npos) << small.err;
+  EXPECT_FALSE(fs::exists(path("s.vtk")));
+  for (std::vector<std::string> bad_arg : {std::vector<std::string>{"--stuck-fill-quads", "0"},
+                                           {"--stuck-fill-budget", "0"}}) {
+    std::vector<std::string> args{"mesh", in, "-o", path("c.vtk")};
+    args.insert(args.end(), bad_arg.begin(), bad_arg.end());
+    const Outcome bad = run(args);
+    EXPECT_EQ(bad.exit_code, 1) << bad.err;
+    EXPECT_FALSE(fs::exists(path("c.vtk")));
+  }
+}
+
 // --regularization: a weaker size term in the passes raises this solid's minimum (measured:
 // 0.4736 -> 0.4841 with 0.003); the weight is range-checked.
 TEST_F(Cli, RegularizationOption) {

@@ -79,6 +79,12 @@ Generated pillowed(const Generated& g, uint64_t seed, double fraction = 0.3);
 /// any direction, so the known mesh is no longer an ideal grid.
 Generated jittered(const Generated& g, uint64_t seed, double amount = 0.1);
 
+/// 20 quads, 22 vertices, 6 chords, none of which can be eliminated (collapsing any would leave
+/// a vertex of valence 2 or an edge with other than two quads): the surface a real surface's
+/// elimination stopped at (a genus-0 cut of a published hex mesh), its vertices embedded on the
+/// unit sphere (graph Laplacian eigenvectors, then spherical Laplacian smoothing).
+QuadSurface stuck_surface();
+
 /// Checks of generated data, each returning "" when fine, else a message naming element ids.
 /// The surface is closed, every edge in two quads traversed oppositely, every vertex used, vertex
 /// fans single, one component, V - E + F = 2.

@@ -6,6 +6,7 @@
 #include "hexpeel/reconstruction.h"
 #include "hexpeel/terminal.h"
 #include "quality/quality_internal.h"
+#include "support/generators.h"
 #include "support/prepared.h"
 
 #include <gtest/gtest.h>
@@ -16,41 +17,8 @@ using namespace hexpeel;
 
 namespace {
 
-/// 20 quads, 22 vertices, 6 chords, none of which can be eliminated (collapsing any would leave
-/// a vertex of valence 2 or an edge with other than two quads): the surface a real surface's
-/// elimination stopped at (a genus-0 cut of a published hex mesh), its vertices embedded on the
-/// unit sphere (graph Laplacian eigenvectors, then spherical Laplacian smoothing).
-QuadSurface stuck_surface() {
-  QuadSurface s;
-  s.points = {
-      {-0.873962, 0.045922, 0.483819},
-      {-0.999975, 0.000979, -0.007019},
-      {-0.898376, -0.437906, 0.034059},
-      {-0.760277, -0.594770, 0.261206},
-      {-0.001618, -0.995795, 0.091594},
-      {0.755369, -0.596254, 0.271844},
-      {0.867173, 0.044217, 0.496040},
-      {-0.006899, 0.091603, 0.995772},
-      {0.001618, 0.995795, -0.091594},
-      {0.757367, 0.633401, 0.158739},
-      {0.896950, -0.439664, 0.046660},
-      {0.999975, -0.000979, 0.007019},
-      {0.898376, 0.437906, -0.034059},
-      {0.006899, -0.091603, -0.995772},
-      {0.873962, -0.045922, -0.483819},
-      {0.758278, -0.634886, -0.148101},
-      {0.760277, 0.594770, -0.261206},
-      {-0.757367, -0.633401, -0.158739},
-      {-0.867173, -0.044217, -0.496040},
-      {-0.758278, 0.634886, 0.148101},
-      {-0.896950, 0.439664, -0.046660},
-      {-0.755369, 0.596254, -0.271844}};
-  s.quads = {{0, 1, 2, 3}, {4, 5, 6, 7}, {8, 7, 6, 9}, {6, 5, 10, 11}, {9, 6, 11, 12}, {4, 13, 14, 15}, {15, 10, 5, 4}, {16, 14, 13, 8}, {9, 12, 16, 8}, {12, 11, 14, 16}, {14, 11, 10, 15}, {4, 3, 2, 17}, {18, 13, 4, 17}, {0, 19, 20, 1}, {8, 13, 18, 21}, {19, 8, 21, 20}, {17, 2, 1, 18}, {21, 18, 1, 20}, {7, 0, 3, 4}, {19, 0, 7, 8}};
-  return s;
-}
-
 TEST(Terminal, PlannerEndsAtADeadRoot) {
-  hexpeel::testing::Prepared p = hexpeel::testing::prepare(stuck_surface());
+  hexpeel::testing::Prepared p = hexpeel::testing::prepare(hexpeel::testing::stuck_surface());
   EliminationState state(p.surface, p.chords, p.edges);
   PlannerResult pr = run_planner(state);
   EXPECT_EQ(pr.plan.status.code, StatusCode::stuck);
@@ -60,7 +28,7 @@ TEST(Terminal, PlannerEndsAtADeadRoot) {
 }
 
 TEST(Terminal, StuckSurfaceIsFilledThroughAPit) {
-  hexpeel::testing::Prepared p = hexpeel::testing::prepare(stuck_surface());
+  hexpeel::testing::Prepared p = hexpeel::testing::prepare(hexpeel::testing::stuck_surface());
   EliminationState state(p.surface, p.chords, p.edges);
   PlannerResult pr = run_planner(state);
   ASSERT_EQ(pr.plan.status.code, StatusCode::stuck);
@@ -99,7 +67,7 @@ TEST(Terminal, StuckSurfaceIsFilledThroughAPit) {
 // hex (26 hexes, min scaled Jacobian 0.226 when written), and without the fill the run fails as
 // stuck.
 TEST(Terminal, PipelineMeshesAStuckSurface) {
-  const PolygonSoup soup = to_polygon_soup(stuck_surface());
+  const PolygonSoup soup = to_polygon_soup(hexpeel::testing::stuck_surface());
   MeshParams mp;
   mp.alternatives = 0;
   MeshResult r = run_mesh(soup, mp);
