@@ -53,11 +53,15 @@ std::vector<int64_t> plan_key(const EliminationPlan& plan) {
 /// The stages after the input checks, with elimination order `order`; fills everything but
 /// `diagnosis`, `tries` and the check time. `plans` holds the keys of the plans meshed before;
 /// when this order plans one of them again, it stops after planning and `same_as` names it.
-/// This order's plan key is appended to `plans` ({-1} when planning failed).
+/// This order's plan key is appended to `plans` ({-1} when planning failed). When
+/// max_plan_hexes > 0 and the plan predicts more hexes, it also stops after planning and sets
+/// `too_large`.
 MeshResult mesh_with_order(const SurfaceDiagnosis& diagnosis, const MeshParams& params,
                            const OrderParams& order, const Context& ctx,
-                           std::vector<std::vector<int64_t>>& plans, int32_t& same_as) {
+                           std::vector<std::vector<int64_t>>& plans, int32_t& same_as,
+                           int64_t max_plan_hexes, bool& too_large) {
   same_as = -1;
+  too_large = false;
   MeshResult r;
   r.method = order;
   const QuadSurface& surface = diagnosis.validation.surface;
@@ -101,6 +105,8 @@ MeshResult mesh_with_order(const SurfaceDiagnosis& diagnosis, const MeshParams& 
     if (plans[i] == key) same_as = static_cast<int32_t>(i);
   plans.push_back(std::move(key));
   if (same_as >= 0) return r;
+  too_large = max_plan_hexes > 0 && r.plan.stats.predicted_hexes > max_plan_hexes;
+  if (too_large) return r;
 
   t = std::chrono::steady_clock::now();
   ReconstructionResult rec = run_reconstruction(surface, r.plan, params.reconstruction, ctx, &state);
@@ -192,6 +198,10 @@ double total_seconds(const MeshTimings& t) {
          t.quality_s;
 }
 
+/// A try made only for refused intrusions builds no plan of more than this many times the
+/// kept mesh's planned hexes (the messages say 1.5).
+constexpr double kMaxPlanGrowth = 1.5;
+
 OrderTry summarize(const MeshResult& r, double seconds) {
   OrderTry t;
   t.method = r.method.method;
@@ -252,7 +262,9 @@ MeshResult run_mesh(const PolygonSoup& soup, const MeshParams& params, const Con
   t = std::chrono::steady_clock::now();
   std::vector<std::vector<int64_t>> plans;
   int32_t same_as = -1;
-  MeshResult best = mesh_with_order(diagnosis, params, params.elimination.order, ctx, plans, same_as);
+  bool too_large = false;
+  MeshResult best = mesh_with_order(diagnosis, params, params.elimination.order, ctx, plans,
+                                    same_as, 0, too_large);
   std::vector<OrderTry> tries{summarize(best, seconds_since(t))};
   double others_s = 0.0;
   const std::vector<OrderParams> alternatives = alternative_orders(params.elimination.order);
@@ -266,7 +278,25 @@ MeshResult run_mesh(const PolygonSoup& soup, const MeshParams& params, const Con
                                 : "looking for a better mesh";
     ctx.info(std::string(why) + ": trying elimination order " + describe(alternatives[i]));
     t = std::chrono::steady_clock::now();
-    MeshResult r = mesh_with_order(diagnosis, params, alternatives[i], ctx, plans, same_as);
+    // A try made only because intrusions were refused is looking for a better placement of
+    // the same shape: a plan of far more hexes than the mesh in hand is not built (a swivel cut:
+    // 43029 hexes against 16679, 25 min on a loaded machine, inverted in the end).
+    const int64_t max_plan_hexes =
+        !invalid && !params.alternatives_always && best.status.ok()
+            ? static_cast<int64_t>(kMaxPlanGrowth * static_cast<double>(best.plan.stats.predicted_hexes))
+            : 0;
+    MeshResult r = mesh_with_order(diagnosis, params, alternatives[i], ctx, plans, same_as,
+                                   max_plan_hexes, too_large);
+    if (too_large) {
+      OrderTry skipped = summarize(r, seconds_since(t));
+      skipped.skipped_plan_hexes = r.plan.stats.predicted_hexes;
+      tries.push_back(skipped);
+      others_s += r.timings.elimination_s;
+      ctx.info("its plan predicts " + std::to_string(r.plan.stats.predicted_hexes) +
+               " hexes, over 1.5 times the " +
+               std::to_string(best.plan.stats.predicted_hexes) + " of the mesh kept: not built");
+      continue;
+    }
     if (same_as >= 0) {  // the same mesh again: not built twice
       OrderTry same = tries[same_as];
       same.method = alternatives[i].method;
@@ -325,7 +355,8 @@ nlohmann::json to_json(const MeshResult& r) {
   j["orders_tried"] = nlohmann::json::array();
   for (size_t i = 0; i < r.tries.size(); ++i) {
     const OrderTry& t = r.tries[i];
-    const bool ok = t.status == StatusCode::ok;  // a failed try has no mesh to describe
+    // A failed try, or one not built, has no mesh to describe.
+    const bool ok = t.status == StatusCode::ok && t.skipped_plan_hexes == 0;
     j["orders_tried"].push_back({{"method", std::string(to_string(t.method))},
                                  {"side_rule", std::string(to_string(t.side_rule))},
                                  {"status", std::string(to_string(t.status))},
@@ -334,6 +365,7 @@ nlohmann::json to_json(const MeshResult& r) {
                                  {"min_sj", ok ? nlohmann::json(t.min_sj) : nlohmann::json()},
                                  {"seconds", t.seconds},
                                  {"same_plan_as", t.same_plan_as},
+                                 {"skipped_plan_hexes", t.skipped_plan_hexes},
                                  {"kept", static_cast<int32_t>(i) == r.kept_try}});
   }
   j["steps"] = r.plan.stats.steps;

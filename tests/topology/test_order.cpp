@@ -263,6 +263,14 @@ TEST(Reconstruction, RefusedIntrusionTriesTheOtherSideRule) {
     ASSERT_EQ(r.tries.size(), 2u) << g.name;
     EXPECT_EQ(r.tries[1].method, Method::kremer);
     EXPECT_NE(r.tries[1].side_rule, r.tries[0].side_rule);
+    // Built unless its plan predicts over 1.5 times the first's hexes.
+    if (r.tries[1].skipped_plan_hexes > 0) {
+      EXPECT_GT(r.tries[1].skipped_plan_hexes, 1.5 * first.plan.stats.predicted_hexes) << g.name;
+      EXPECT_EQ(r.kept_try, 0) << g.name;
+      EXPECT_TRUE(to_json(r)["orders_tried"][1]["hexes"].is_null()) << g.name;
+    } else {
+      EXPECT_GT(r.tries[1].hexes, 0) << g.name;
+    }
     EXPECT_GE(r.quality.sj_min, first.quality.sj_min) << g.name;
     QualityReport q = run_quality(r.mesh, {}, &g.surface);
     EXPECT_TRUE(q.is_ball && q.boundary_matches_surface == true) << g.name;
