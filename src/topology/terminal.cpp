@@ -324,14 +324,16 @@ bool fill_surface(const QuadSurface& s, const TerminalParams& params, const Plan
   // furthest first. One pit rarely unblocks every chord of a large stuck surface, but it often
   // lets elimination go on to a smaller one.
   const std::vector<Candidate> cands = candidate_pits(s, nb);
+  auto attempt = [&](size_t i, bool nest, int32_t& stuck_quads) {
+    --budget.tries;
+    return fill_with_pit(s, dig(s, nb, cands[i].disc), params, planner, depth, nest, budget, out,
+                         stuck_quads);
+  };
   std::vector<std::pair<int32_t, size_t>> progress;  // (stuck quads, candidate)
   for (size_t i = 0; i < cands.size(); ++i) {
     if (!budget.left()) return false;
-    --budget.tries;
     int32_t stuck_quads = -1;
-    if (fill_with_pit(s, dig(s, nb, cands[i].disc), params, planner, depth, false, budget, out,
-                      stuck_quads))
-      return true;
+    if (attempt(i, false, stuck_quads)) return true;
     if (stuck_quads >= 0 && stuck_quads < s.num_quads()) progress.emplace_back(stuck_quads, i);
   }
   if (depth <= 1) return false;
@@ -339,11 +341,8 @@ bool fill_surface(const QuadSurface& s, const TerminalParams& params, const Plan
   if (progress.size() > static_cast<size_t>(params.descend)) progress.resize(params.descend);
   for (const auto& [stuck_quads, i] : progress) {
     if (!budget.left()) return false;
-    --budget.tries;
     int32_t again = -1;
-    if (fill_with_pit(s, dig(s, nb, cands[i].disc), params, planner, depth, true, budget, out,
-                      again))
-      return true;
+    if (attempt(i, true, again)) return true;
   }
   return false;
 }
