@@ -166,6 +166,8 @@ int cmd_mesh(const std::string& in, const std::string& out, const std::string& r
                     std::string(to_string(t.side_rule)).c_str());
         if (t.same_plan_as >= 0)
           std::printf("same plan as try %d", t.same_plan_as + 1);
+        else if (t.skipped_plan_hexes > 0)
+          std::printf("not built (plan of %lld hexes)", static_cast<long long>(t.skipped_plan_hexes));
         else if (t.status == StatusCode::ok)
           std::printf("min %.4f, %d hexes <= 0", t.min_sj, t.nonpositive);
         else

@@ -60,7 +60,8 @@ struct OrderTry {
   /// so it was not built again (the outcome fields are copied from that try); -1 otherwise.
   int32_t same_plan_as = -1;
   /// A try made only because intrusions were refused whose plan predicted more than 1.5 times
-  /// the hexes of the mesh kept: not built (its predicted hex count); 0 otherwise.
+  /// the hexes predicted by the plan of the mesh kept: not built (its predicted hex count; the
+  /// status stays ok, the outcome fields are null in the JSON); 0 otherwise.
   int64_t skipped_plan_hexes = 0;
 };
 

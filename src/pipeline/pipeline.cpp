@@ -293,8 +293,8 @@ MeshResult run_mesh(const PolygonSoup& soup, const MeshParams& params, const Con
       tries.push_back(skipped);
       others_s += r.timings.elimination_s;
       ctx.info("its plan predicts " + std::to_string(r.plan.stats.predicted_hexes) +
-               " hexes, over 1.5 times the " +
-               std::to_string(best.plan.stats.predicted_hexes) + " of the mesh kept: not built");
+               " hexes, over 1.5 times the " + std::to_string(best.plan.stats.predicted_hexes) +
+               " planned for the mesh kept: not built");
       continue;
     }
     if (same_as >= 0) {  // the same mesh again: not built twice

@@ -115,7 +115,7 @@ Pit dig(const QuadSurface& s, const std::vector<int32_t>& nb, const std::vector<
       if (!in_f(nb[4 * q + k])) {
         const int32_t a = t[k], b = t[(k + 1) & 3];
         p.surface.quads.push_back({keep[a], keep[b], copy[b], copy[a]});
-          }
+      }
   }
   // On a closed manifold surface a vertex has as many edges as quads; every edge lies in two
   // quads, so each blocking edge is seen twice.

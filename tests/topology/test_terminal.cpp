@@ -64,7 +64,7 @@ TEST(Terminal, StuckSurfaceIsFilledThroughAPit) {
 }
 
 // Through the pipeline: a mesh that is a ball with the surface as its boundary and no inverted
-// hex (26 hexes, min scaled Jacobian 0.226 when written), and without the fill the run fails as
+// hex (40 hexes, min scaled Jacobian 0.337 when written), and without the fill the run fails as
 // stuck.
 TEST(Terminal, PipelineMeshesAStuckSurface) {
   const PolygonSoup soup = to_polygon_soup(hexpeel::testing::stuck_surface());
