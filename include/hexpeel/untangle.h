@@ -223,11 +223,13 @@ struct UntangleParams {
   /// Rounds of final polish and mean sweeps (>= 1): each further round starts from where the
   /// last left the points and is kept only if it raises the mean (over the hexes of their worst
   /// active term); the rounds stop at the first that does not, or when the first polish was not
-  /// kept. 1 by default for time: 3 rounds on 77 surfaces raised the mean on 20 and lowered it on
-  /// none (gear_fine 0.903 -> 0.923, disk 0.850 -> 0.855, vase 0.977 -> 0.980), screw2 0.606 ->
-  /// 0.620 and pierrot 0.7989 -> 0.7997, for 32% more untangling time on the 77 (gear_fine 12.4
-  /// -> 20.2 s) and 7 s more on pierrot.
-  int final_polish_rounds = 1;
+  /// kept. 2 by default (was 1): on 67 generated, CAD-like and cubed-sphere surfaces the mean
+  /// rose on 15 and fell on none (by at most 0.001: a pillowed voxel solid 0.7186 -> 0.7195),
+  /// the minima the same; screw2 0.0685 / 0.6211 -> 0.0695 / 0.6359, pierrot 0.3387 / 0.8058 ->
+  /// 0.3387 / 0.8069 (its published mesh: 0.222 / 0.806), for 5-20% more time on small meshes in
+  /// alternating runs (a 10,400-hex cubed sphere 6.4 -> 6.8-7.3 s on a slow day) and about the
+  /// same on pierrot. 3 rounds: pierrot 0.8071.
+  int final_polish_rounds = 2;
   /// Phase 2 restarts (re-centred on the new minimum), 0..1000; they also stop once a restart
   /// raises the minimum corner s by less than 1e-3. 6 (was 4): with focus_width the restarts are
   /// cheap, and csphere_n12 still gained 0.005 in its 4th. 8 since restart_delta 1e-5 made each
