@@ -156,7 +156,8 @@ int cmd_mesh(const std::string& in, const std::string& out, const std::string& r
                 out.c_str(), q.hexes,
                 read_s + r.timings.check_s + r.timings.elimination_s + r.timings.reconstruction_s +
                     r.timings.pillow_s + r.timings.placement_s + r.timings.untangle_s +
-                    r.timings.quality_s + r.timings.other_orders_s + write_s,
+                    r.timings.quality_s + r.timings.pillow_retry_s + r.timings.other_orders_s +
+                    write_s,
                 std::string(to_string(r.method.method)).c_str(), r.plan.stats.concave_steps);
     if (r.tries.size() > 1) {
       std::printf("elimination orders tried:");
@@ -186,6 +187,15 @@ int cmd_mesh(const std::string& in, const std::string& out, const std::string& r
                   r.pillow.forced, r.pillow.flat_doublets, r.pillow.concave_corners,
                   r.pillow.fixed_corners, r.pillow.collinear, r.pillow.shrink_set,
                   r.pillow.whole_boundary ? " (whole boundary)" : "", r.pillow.new_hexes);
+    if (r.pillow_retry.tried) {
+      const PillowRetryStats& pr = r.pillow_retry;
+      std::printf("pillow retry (the minimum was a corner fixed by the boundary, %.4f): corners up "
+                  "to %.4f pillowed, %d hexes min %.4f mean %.4f against %d hexes min %.4f mean "
+                  "%.4f; %s kept\n",
+                  pr.forced_min_sj, pr.forced_sj, pr.retry_hexes, pr.retry_min_sj, pr.retry_mean_sj,
+                  pr.first_hexes, pr.first_min_sj, pr.first_mean_sj,
+                  pr.kept ? "the retry" : "the first mesh");
+    }
     if (q.sj_count_nonpositive > 0) {
       if (params.untangle.untangle)
         std::printf("note: %d hexes are inverted or degenerate after untangling (%d corners are "
@@ -346,6 +356,13 @@ int main(int argc, char** argv) {
   mesh->add_option("--pillow-whole-fraction", params.pillow.whole_fraction,
                    "--pillow auto: pillow the whole boundary instead when the local shrink set "
                    "holds at least this fraction of the hexes at the boundary (1 = always local)")
+      ->check(CLI::Range(0.0, 1.0))->capture_default_str();
+  mesh->add_option("--pillow-retry-band", params.pillow_retry_band,
+                   "--pillow auto: when the optimized mesh's minimum scaled Jacobian is a corner "
+                   "fixed by the boundary (no placement can raise it), pillow again counting the "
+                   "corners up to this much above the minimum as forced, and keep the better mesh "
+                   "(fewer hexes <= 0, or a minimum raised by more than the mean falls); 0 = no "
+                   "retry")
       ->check(CLI::Range(0.0, 1.0))->capture_default_str();
   mesh->add_option("--pillow-margin", params.pillow.target_margin,
                    "inward margin (0..1, unit normals) the pillow keeps at a boundary vertex's "

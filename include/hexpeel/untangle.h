@@ -20,6 +20,7 @@
 #include "hexpeel/status.h"
 
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -295,6 +296,9 @@ struct UntangleStats {
   int32_t active_corners = 0;   ///< corner tetrahedra in the energy (some point free)
   int32_t forced_corners = 0;   ///< left out: all 4 points fixed, or the fixed ones collinear
   int32_t forced_nonpositive = 0;  ///< forced corners with det <= 0: no placement fixes them
+  /// The smallest scaled Jacobian (det of the unit edge vectors) of a forced corner: no placement
+  /// of the free points can take the mesh's minimum above it. +infinity when there is none.
+  double forced_min_sj = std::numeric_limits<double>::infinity();
   UntanglePhaseStats untangle, optimize;
   /// phase 2 ended with a lower minimum and ran again without its restarts (the only step that
   /// can lower it): polish and sweeps from the untangled points. local_moves, quality_passes and

@@ -265,9 +265,11 @@ struct Problem {
 /// Fills `prob` (whose `base` holds the scaled points) for the free vertices of `fixed`: the
 /// active corners, grouped by hex (Newton assembly), and the evaluation layout. A corner whose 4
 /// points are fixed, or whose 3 fixed points are collinear, cannot change its sign and is left
-/// out; `forced` / `forced_nonpositive` (optional) count those and the ones with det <= 0.
+/// out; `forced` / `forced_nonpositive` (optional) count those and the ones with det <= 0, and
+/// `forced_min` (optional) gets the smallest det of their unit edge vectors (-1 for a zero edge).
 void build_problem(Problem& prob, const std::vector<Hex>& hexes, const std::vector<uint8_t>& fixed,
-                   double collinear_tol, int32_t* forced, int32_t* forced_nonpositive) {
+                   double collinear_tol, int32_t* forced, int32_t* forced_nonpositive,
+                   double* forced_min = nullptr) {
   const int32_t np = static_cast<int32_t>(prob.base.size());
   prob.free_index.assign(np, -1);
   prob.free_point.clear();
@@ -300,6 +302,10 @@ void build_problem(Problem& prob, const std::vector<Hex>& hexes, const std::vect
         const Vec3 e0 = prob.base[k[1]] - prob.base[k[0]], e1 = prob.base[k[2]] - prob.base[k[0]],
                    e2 = prob.base[k[3]] - prob.base[k[0]];
         if (forced_nonpositive && e0.dot(e1.cross(e2)) <= 0.0) ++*forced_nonpositive;
+        if (forced_min) {
+          const double l = e0.norm() * e1.norm() * e2.norm();
+          *forced_min = std::min(*forced_min, l > 0.0 ? e0.dot(e1.cross(e2)) / l : -1.0);
+        }
       } else {
         prob.corners.push_back(k);
         mask |= static_cast<uint16_t>(1u << c);
@@ -954,13 +960,16 @@ UntangleResult untangle_once(const HexMesh& mesh, const std::vector<uint8_t>& fi
   for (int32_t v = 0; v < np; ++v) prob.base[v] = (mesh.points[v] - centre) / unit;
 
   int32_t forced = 0, forced_nonpositive = 0;
-  build_problem(prob, mesh.hexes, fixed, params.collinear_tol, &forced, &forced_nonpositive);
+  double forced_min = std::numeric_limits<double>::infinity();
+  build_problem(prob, mesh.hexes, fixed, params.collinear_tol, &forced, &forced_nonpositive,
+                &forced_min);
   const int32_t nu = static_cast<int32_t>(prob.free_point.size()), nc = prob.num_corners();
   res.stats.solver = params.solver;
   res.stats.eps_rule = params.eps_rule;
   res.stats.free_vertices = nu;
   res.stats.forced_corners = forced;
   res.stats.forced_nonpositive = forced_nonpositive;
+  res.stats.forced_min_sj = forced_min;
   res.stats.active_corners = nc;
   if (nu == 0 || prob.num_hexes() == 0) {
     res.stats.time_s = seconds_since(t_start);

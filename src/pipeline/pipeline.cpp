@@ -5,7 +5,9 @@
 #include "hexpeel/pipeline.h"
 
 #include <algorithm>
+#include <cmath>
 #include <chrono>
+#include <cstdio>
 
 namespace hexpeel {
 namespace {
@@ -48,6 +50,124 @@ std::vector<int64_t> plan_key(const EliminationPlan& plan) {
     for (const Hex& h : plan.terminal.hexes) key.insert(key.end(), h.begin(), h.end());
   }
   return key;
+}
+
+/// Pillows `complex` as `pillow` says, places, untangles and optimizes it and checks the result:
+/// r's pillow, forced, placement, untangle, mesh, quality and status, and their timings.
+void embed(const QuadSurface& surface, const HexComplex& complex, const MeshParams& params,
+           const PillowParams& pillow, const Context& ctx, MeshResult& r) {
+  auto t = std::chrono::steady_clock::now();
+  PillowResult pillowed = run_pillow(surface, complex, pillow, ctx);
+  r.pillow = pillowed.stats;
+  r.forced = std::move(pillowed.forced);
+  r.timings.pillow_s = seconds_since(t);
+  if (!pillowed.status.ok()) {
+    r.status = pillowed.status;
+    return;
+  }
+
+  t = std::chrono::steady_clock::now();
+  PlacementResult placed = run_placement(surface, pillowed.complex, params.placement, ctx);
+  r.placement = placed.stats;
+  r.timings.placement_s = seconds_since(t);
+  if (!placed.status.ok()) {
+    r.status = placed.status;
+    return;
+  }
+  r.mesh = renumber(placed.mesh, pillowed.complex, surface.num_points());
+
+  if (params.untangle.untangle || params.untangle.optimize) {
+    t = std::chrono::steady_clock::now();
+    std::vector<uint8_t> fixed(r.mesh.points.size(), 0);
+    std::fill(fixed.begin(), fixed.begin() + surface.num_points(), uint8_t{1});
+    UntangleResult u = run_untangle(r.mesh, fixed, params.untangle, ctx);
+    r.untangle = u.stats;
+    r.timings.untangle_s = seconds_since(t);
+    if (!u.status.ok()) {
+      r.status = u.status;
+      return;
+    }
+    r.mesh = std::move(u.mesh);
+  }
+
+  t = std::chrono::steady_clock::now();
+  r.quality = run_quality(r.mesh, params.quality, &surface, ctx);
+  r.timings.quality_s = seconds_since(t);
+  if (!r.quality.is_ball || r.quality.boundary_matches_surface != true) {
+    r.status = Status::error(StatusCode::internal_error,
+                             "the constructed complex failed its final check: " +
+                                 r.quality.topology_message + " " + r.quality.boundary_message);
+  }
+}
+
+double embedding_seconds(const MeshTimings& t) {
+  return t.pillow_s + t.placement_s + t.untangle_s + t.quality_s;
+}
+
+/// MeshParams::pillow_retry_band: when r's minimum is held by a forced corner, embeds `complex`
+/// again with a pillow that also counts the corners up to the band above the minimum as forced,
+/// and keeps what is better (fewer hexes <= 0; or as many and a minimum raised by more than the
+/// mean falls). Not when the whole boundary was pillowed (the retry would pillow it again), when
+/// the minimum is within the band of 1, and when no more corners count as forced.
+void retry_pillow(const QuadSurface& surface, const HexComplex& complex, const MeshParams& params,
+                  const Context& ctx, MeshResult& r) {
+  if (params.pillow.mode != PillowMode::automatic || !(params.pillow_retry_band > 0.0) ||
+      !params.untangle.untangle || !params.untangle.optimize || r.pillow.whole_boundary)
+    return;
+  // The untangler's forced corners and Verdict's minimum are the same determinants, computed
+  // in another order: equal within rounding when the minimum is a forced corner's.
+  if (!(r.untangle.forced_min_sj <= r.quality.sj_min + 1e-9)) return;
+  // Within the band of a perfect hex (a voxel solid meshed by its cubes) there is nothing to win.
+  if (r.quality.sj_min + params.pillow_retry_band >= 1.0) return;
+  PillowParams pillow = params.pillow;
+  pillow.forced_sj = std::max(params.pillow.forced_sj, r.quality.sj_min + params.pillow_retry_band);
+  if (find_forced_configurations(surface, complex, pillow.forced_sj).size() ==
+      find_forced_configurations(surface, complex, params.pillow.forced_sj).size())
+    return;  // nothing more counts as forced: the same pillow
+  char msg[160];
+  std::snprintf(msg, sizeof msg,
+                "the minimum scaled Jacobian (%.4f) is a corner fixed by the boundary: pillowing "
+                "again with corners up to %.4f counted as forced",
+                r.quality.sj_min, pillow.forced_sj);
+  ctx.info(msg);
+  MeshResult retry;
+  embed(surface, complex, params, pillow, ctx, retry);
+  PillowRetryStats s;
+  s.tried = true;
+  s.forced_sj = pillow.forced_sj;
+  s.forced_min_sj = r.untangle.forced_min_sj;
+  s.first_hexes = r.quality.hexes;
+  s.first_min_sj = r.quality.sj_min;
+  s.first_mean_sj = r.quality.sj_mean;
+  s.first_nonpositive = r.quality.sj_count_nonpositive;
+  if (retry.status.ok()) {
+    s.retry_hexes = retry.quality.hexes;
+    s.retry_min_sj = retry.quality.sj_min;
+    s.retry_mean_sj = retry.quality.sj_mean;
+    s.retry_nonpositive = retry.quality.sj_count_nonpositive;
+    const double gain = retry.quality.sj_min - r.quality.sj_min;
+    const double loss = r.quality.sj_mean - retry.quality.sj_mean;
+    s.kept = s.retry_nonpositive != s.first_nonpositive
+                 ? s.retry_nonpositive < s.first_nonpositive
+                 : gain > 0.0 && gain >= loss;
+  }
+  const MeshTimings first = r.timings;
+  if (s.kept) {
+    r.pillow = retry.pillow;
+    r.forced = std::move(retry.forced);
+    r.placement = retry.placement;
+    r.untangle = retry.untangle;
+    r.mesh = std::move(retry.mesh);
+    r.quality = std::move(retry.quality);
+    r.timings.pillow_s = retry.timings.pillow_s;
+    r.timings.placement_s = retry.timings.placement_s;
+    r.timings.untangle_s = retry.timings.untangle_s;
+    r.timings.quality_s = retry.timings.quality_s;
+    r.timings.pillow_retry_s = embedding_seconds(first);
+  } else {
+    r.timings.pillow_retry_s = embedding_seconds(retry.timings);
+  }
+  r.pillow_retry = s;
 }
 
 /// The stages after the input checks, with elimination order `order`; fills everything but
@@ -117,49 +237,8 @@ MeshResult mesh_with_order(const SurfaceDiagnosis& diagnosis, const MeshParams& 
     return r;
   }
 
-  t = std::chrono::steady_clock::now();
-  PillowResult pillowed = run_pillow(surface, rec.complex, params.pillow, ctx);
-  r.pillow = pillowed.stats;
-  r.forced = std::move(pillowed.forced);
-  r.timings.pillow_s = seconds_since(t);
-  if (!pillowed.status.ok()) {
-    r.status = pillowed.status;
-    return r;
-  }
-  rec.complex = std::move(pillowed.complex);
-
-  t = std::chrono::steady_clock::now();
-  PlacementResult placed = run_placement(surface, rec.complex, params.placement, ctx);
-  r.placement = placed.stats;
-  r.timings.placement_s = seconds_since(t);
-  if (!placed.status.ok()) {
-    r.status = placed.status;
-    return r;
-  }
-  r.mesh = renumber(placed.mesh, rec.complex, surface.num_points());
-
-  if (params.untangle.untangle || params.untangle.optimize) {
-    t = std::chrono::steady_clock::now();
-    std::vector<uint8_t> fixed(r.mesh.points.size(), 0);
-    std::fill(fixed.begin(), fixed.begin() + surface.num_points(), uint8_t{1});
-    UntangleResult u = run_untangle(r.mesh, fixed, params.untangle, ctx);
-    r.untangle = u.stats;
-    r.timings.untangle_s = seconds_since(t);
-    if (!u.status.ok()) {
-      r.status = u.status;
-      return r;
-    }
-    r.mesh = std::move(u.mesh);
-  }
-
-  t = std::chrono::steady_clock::now();
-  r.quality = run_quality(r.mesh, params.quality, &surface, ctx);
-  r.timings.quality_s = seconds_since(t);
-  if (!r.quality.is_ball || r.quality.boundary_matches_surface != true) {
-    r.status = Status::error(StatusCode::internal_error,
-                             "the constructed complex failed its final check: " +
-                                 r.quality.topology_message + " " + r.quality.boundary_message);
-  }
+  embed(surface, rec.complex, params, params.pillow, ctx, r);
+  if (r.status.ok()) retry_pillow(surface, rec.complex, params, ctx, r);
   return r;
 }
 
@@ -195,7 +274,7 @@ bool refused_intrusions(const MeshResult& r, const MeshParams& params) {
 
 double total_seconds(const MeshTimings& t) {
   return t.elimination_s + t.reconstruction_s + t.pillow_s + t.placement_s + t.untangle_s +
-         t.quality_s;
+         t.quality_s + t.pillow_retry_s;
 }
 
 /// A try made only for refused intrusions builds no plan of more than this many times the
@@ -439,6 +518,20 @@ nlohmann::json to_json(const MeshResult& r) {
                    {"new_vertices", p.new_vertices},
                    {"whole_boundary", p.whole_boundary},
                    {"passes", p.passes}};
+    const PillowRetryStats& pr = r.pillow_retry;
+    j["pillow_retry"] = {{"tried", pr.tried}, {"kept", pr.kept}};
+    if (pr.tried) {
+      j["pillow_retry"]["forced_sj"] = pr.forced_sj;
+      j["pillow_retry"]["forced_min_sj"] = pr.forced_min_sj;
+      j["pillow_retry"]["first"] = {{"hexes", pr.first_hexes},
+                                    {"min_sj", pr.first_min_sj},
+                                    {"mean_sj", pr.first_mean_sj},
+                                    {"nonpositive", pr.first_nonpositive}};
+      j["pillow_retry"]["retry"] = {{"hexes", pr.retry_hexes},
+                                    {"min_sj", pr.retry_min_sj},
+                                    {"mean_sj", pr.retry_mean_sj},
+                                    {"nonpositive", pr.retry_nonpositive}};
+    }
     const UntangleStats& u = r.untangle;
     auto phase = [](const UntanglePhaseStats& s) {
       return nlohmann::json{{"rounds", s.rounds},
@@ -456,6 +549,8 @@ nlohmann::json to_json(const MeshResult& r) {
                      {"active_corners", u.active_corners},
                      {"forced_corners", u.forced_corners},
                      {"forced_nonpositive", u.forced_nonpositive},
+                     {"forced_min_sj", std::isfinite(u.forced_min_sj) ? nlohmann::json(u.forced_min_sj)
+                                                                       : nlohmann::json(nullptr)},
                      {"eps_rule", std::string(to_string(u.eps_rule))},
                      {"stalled", u.stalled},
                      {"continuation_run", u.continuation_run},
@@ -483,6 +578,7 @@ nlohmann::json to_json(const MeshResult& r) {
                     {"placement", r.timings.placement_s},
                     {"untangle", r.timings.untangle_s},
                     {"quality", r.timings.quality_s},
+                    {"pillow_retry", r.timings.pillow_retry_s},
                     {"other_orders", r.timings.other_orders_s}};
   return j;
 }

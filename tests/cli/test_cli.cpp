@@ -508,6 +508,32 @@ TEST_F(Cli, StuckFillOptions) {
   }
 }
 
+// --pillow-retry-band: the report's pillow_retry on a coarse cubed sphere whose minimum is a
+// corner fixed by the boundary (the retry pillows it: 64 -> 160 hexes), 0 turns it off, and the
+// band is range-checked.
+TEST_F(Cli, PillowRetryBandOption) {
+  const std::string in = write("cs4.obj", gen::cubed_sphere_equiangular(4).surface);
+  auto report = [&](const std::vector<std::string>& extra) {
+    std::vector<std::string> args{"mesh", in, "-o", path("m.vtk"), "--report", path("m.json"), "-q"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const Outcome o = run(args);
+    EXPECT_EQ(o.exit_code, 0) << o.err;
+    return nlohmann::json::parse(slurp(path("m.json")));
+  };
+  const nlohmann::json on = report({}), off = report({"--pillow-retry-band", "0"});
+  EXPECT_TRUE(on.at("pillow_retry").at("tried").get<bool>());
+  EXPECT_TRUE(on.at("pillow_retry").at("kept").get<bool>());
+  EXPECT_EQ(on.at("pillow_retry").at("first").at("hexes").get<int>(), off.at("hexes").get<int>());
+  EXPECT_EQ(on.at("pillow_retry").at("retry").at("hexes").get<int>(), on.at("hexes").get<int>());
+  EXPECT_GT(on.at("timings_s").at("pillow_retry").get<double>(), 0.0);
+  EXPECT_FALSE(off.at("pillow_retry").at("tried").get<bool>());
+  EXPECT_GT(on.at("scaled_jacobian").at("min").get<double>(),
+            off.at("scaled_jacobian").at("min").get<double>() + 0.3);
+  const Outcome bad = run({"mesh", in, "-o", path("c.vtk"), "--pillow-retry-band", "1.5"});
+  EXPECT_EQ(bad.exit_code, 1) << bad.err;
+  EXPECT_FALSE(fs::exists(path("c.vtk")));
+}
+
 // --regularization: a weaker size term in the passes raises this solid's minimum (measured:
 // 0.4736 -> 0.4841 with 0.003); the weight is range-checked.
 TEST_F(Cli, RegularizationOption) {
