@@ -196,6 +196,13 @@ int cmd_mesh(const std::string& in, const std::string& out, const std::string& r
                   pr.first_hexes, pr.first_min_sj, pr.first_mean_sj,
                   pr.kept ? "the retry" : "the first mesh");
     }
+    if (r.pillow_repair.tried) {
+      const PillowRetryStats& pr = r.pillow_repair;
+      std::printf("repair pillow: %d of %d rounds kept (%d new hexes), %d hexes <= 0 (min "
+                  "%.4f) against %d (min %.4f) before\n",
+                  pr.rounds_kept, pr.rounds, pr.new_hexes, pr.retry_nonpositive, pr.retry_min_sj,
+                  pr.first_nonpositive, pr.first_min_sj);
+    }
     if (q.sj_count_nonpositive > 0) {
       if (params.untangle.untangle)
         std::printf("note: %d hexes are inverted or degenerate after untangling (%d corners are "
@@ -364,6 +371,11 @@ int main(int argc, char** argv) {
                    "(fewer hexes <= 0, or a minimum raised by more than the mean falls); 0 = no "
                    "retry")
       ->check(CLI::Range(0.0, 1.0))->capture_default_str();
+  mesh->add_option("--repair-rounds", params.repair_rounds,
+                   "while hexes stay <= 0 after untangling: rounds of a local pillow around them "
+                   "and untangling again, each kept only when fewer hexes stay <= 0 (before other "
+                   "elimination orders are tried); 0 = none")
+      ->check(CLI::Range(0, 20))->capture_default_str();
   mesh->add_option("--pillow-margin", params.pillow.target_margin,
                    "inward margin (0..1, unit normals) the pillow keeps at a boundary vertex's "
                    "copy by keeping hexes that are not forced out of the shrink set there: the "

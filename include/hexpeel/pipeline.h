@@ -35,6 +35,13 @@ struct MeshParams {
   /// where it acts: a 90-quad ellipsoid from a published dataset, 50 hexes at 0.41 / 0.70, gets
   /// the whole layer, 140 hexes at 0.73 / 0.85 (its published mesh: 0.52 / 0.81).
   double pillow_retry_band = 0.1;
+  /// Repair rounds (>= 0, 0 = none): while the untangled mesh keeps hexes with SJ <= 0, its
+  /// complex is pillowed once more, locally around those hexes (each grown by PillowParams::grow
+  /// rings and added while the set still pillows to a ball, fitted to the boundary like any
+  /// shrink set), placed and untangled again; a round is kept when fewer hexes stay <= 0, and
+  /// the rounds stop at the first that is not. Before other elimination orders are tried; not
+  /// with --pillow none or --no-untangle.
+  int repair_rounds = 3;
   PlacementParams placement;
   UntangleParams untangle;        ///< untangling and quality optimization, after placement
   QualityParams quality;
@@ -54,16 +61,23 @@ struct MeshTimings {
   double pillow_s = 0, untangle_s = 0;
   double other_orders_s = 0;  ///< the tries that were not kept (the given order's too when
                               ///< another was kept)
-  double pillow_retry_s = 0;  ///< pillow, placement, untangling and quality of the embedding
-                              ///< not kept when the pillow was retried
+  double pillow_retry_s = 0;  ///< pillow, placement, untangling and quality of the embeddings
+                              ///< not kept by the pillow retry and the repair pillow
 };
-/// The pillow retry (MeshParams::pillow_retry_band) of the order kept.
+/// The pillow retry (MeshParams::pillow_retry_band) or the repair pillow
+/// (MeshParams::repair_pillow) of the order kept.
 struct PillowRetryStats {
-  bool tried = false;        ///< the minimum was a forced corner's and the retry pillowed more
-  bool kept = false;         ///< the retried mesh is the one returned
-  double forced_sj = 0.0;    ///< the retry's PillowParams::forced_sj
-  double forced_min_sj = 0.0;  ///< the forced corner bound that set off the retry
-  int32_t first_hexes = 0, retry_hexes = 0;  ///< hexes of the two meshes
+  bool tried = false;        ///< retry: the minimum was a forced corner's and the retry pillowed
+                             ///< more; repair: hexes stayed <= 0
+  bool kept = false;         ///< the retried (repaired) mesh is the one returned
+  double forced_sj = 0.0;    ///< the retry's PillowParams::forced_sj (repair: -1, seeds only)
+  double forced_min_sj = 0.0;  ///< retry: the forced corner bound that set it off
+  int32_t seed_hexes = 0;    ///< repair: the hexes <= 0 the rounds kept pillowed around
+  int32_t new_hexes = 0;     ///< repair: hexes the pillows of the rounds kept added
+  int32_t rounds = 0;        ///< repair: rounds embedded (a pillow that found no set is none)
+  int32_t rounds_kept = 0;   ///< repair: rounds kept
+  int32_t first_hexes = 0, retry_hexes = 0;  ///< hexes of the two meshes (repair: before the
+                                             ///< rounds and of the mesh returned)
   double first_min_sj = 0.0, first_mean_sj = 0.0;  ///< quality of the first mesh
   double retry_min_sj = 0.0, retry_mean_sj = 0.0;  ///< ... and of the retried one
   int32_t first_nonpositive = 0, retry_nonpositive = 0;
@@ -97,6 +111,7 @@ struct MeshResult {
   PillowStats pillow;
   std::vector<ForcedConfiguration> forced;  ///< found after reconstruction (before pillowing)
   PillowRetryStats pillow_retry;
+  PillowRetryStats pillow_repair;
   PlacementStats placement;
   UntangleStats untangle;
   HexMesh mesh;                  ///< when status ok: boundary vertices first, in input order

@@ -413,15 +413,38 @@ bool pillow_once(const QuadSurface& surface, const HexComplex& complex,
     return false;
   };
 
-  bool have = false;
-  if (local) {
-    std::vector<uint8_t> in_s = forced_hex;
+  auto grown = [&](std::vector<uint8_t> in_s) {
     for (int ring = 0; ring < params.grow; ++ring) {
       std::vector<uint8_t> next = in_s;
       for (int32_t s = 0; s < 6 * nh; ++s)
         if (in_s[s / 6] && nb[s] >= 0) next[nb[s] / 6] = 1;
       in_s.swap(next);
     }
+    return in_s;
+  };
+  bool have = false;
+  if (local && params.local_only) {
+    // The repair pillow: the grown forced hexes together may not be a ball (two of them meeting
+    // in an edge); each forced hex's grown set joins S only if S stays one that pillows to a
+    // ball, in the order given.
+    std::vector<uint8_t> in_s(nh, 0);
+    for (const ForcedConfiguration& f : forced) {
+      if (in_s[f.hex]) continue;
+      std::vector<uint8_t> one(nh, 0);
+      one[f.hex] = 1;
+      std::vector<uint8_t> candidate = grown(std::move(one));
+      for (int32_t h = 0; h < nh; ++h) candidate[h] |= in_s[h];
+      PillowPass p;
+      if (attempt(candidate, false, true, &p)) {
+        in_s.swap(candidate);
+        *out = std::move(p);
+        have = true;
+      }
+    }
+    return have;
+  }
+  if (local) {
+    std::vector<uint8_t> in_s = grown(forced_hex);
     int32_t touching = 0;  // hexes with a vertex on the boundary
     for (const Hex& h : complex.hexes)
       for (int32_t v : h)
@@ -463,8 +486,15 @@ PillowResult run_pillow(const QuadSurface& surface, const HexComplex& complex,
     if (f.kind == ForcedKind::collinear) ++st.collinear;
   }
   st.forced_after = st.forced;
+  // Seed hexes join the first pass's forced hexes (pillow_once reads only their hex ids).
+  std::vector<ForcedConfiguration> forced = res.forced;
+  for (int32_t h : params.seed_hexes)
+    if (h >= 0 && h < static_cast<int32_t>(complex.hexes.size())) {
+      forced.push_back({h, -1, ForcedKind::fixed_corner, 0.0});
+      ++st.seed_hexes;
+    }
   const bool want = params.mode == PillowMode::all ||
-                    (params.mode == PillowMode::automatic && st.forced > 0);
+                    (params.mode == PillowMode::automatic && !forced.empty());
   if (!want || complex.hexes.empty()) {
     st.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return res;
@@ -475,7 +505,6 @@ PillowResult run_pillow(const QuadSurface& surface, const HexComplex& complex,
   // Later passes: a forced hex that had to stay out of S (at a saddle, its quads and those of
   // the other pillowed hexes there have no common inward direction) is pillowed again, locally,
   // with a second copy of the vertex. Each later pass must lower the defects.
-  std::vector<ForcedConfiguration> forced = res.forced;
   int32_t defects = st.forced;
   int32_t unserved = 0;  // copies without an inward direction, summed over the passes kept
   const int max_passes = std::max(1, params.max_passes);
@@ -486,7 +515,8 @@ PillowResult run_pillow(const QuadSurface& surface, const HexComplex& complex,
       nb = face_neighbours(res.complex.hexes);
       corners = boundary_corners(surface, res.complex, nb);
     }
-    if (!pillow_once(surface, res.complex, nb, corners, forced, params, local, pass == 0, &p)) {
+    if (!pillow_once(surface, res.complex, nb, corners, forced, params, local,
+                     pass == 0 && !params.local_only, &p)) {
       if (pass == 0) ctx.warn("pillow: no shrink set gave a ball complex; the mesh is not pillowed");
       break;
     }

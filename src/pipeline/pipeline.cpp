@@ -54,19 +54,29 @@ std::vector<int64_t> plan_key(const EliminationPlan& plan) {
 
 /// Pillows `complex` as `pillow` says, places, untangles and optimizes it and checks the result:
 /// r's pillow, forced, placement, untangle, mesh, quality and status, and their timings.
+void embed_pillowed(const QuadSurface& surface, PillowResult pillowed, const MeshParams& params,
+                    const Context& ctx, MeshResult& r, HexComplex* used);
+
 void embed(const QuadSurface& surface, const HexComplex& complex, const MeshParams& params,
-           const PillowParams& pillow, const Context& ctx, MeshResult& r) {
-  auto t = std::chrono::steady_clock::now();
+           const PillowParams& pillow, const Context& ctx, MeshResult& r,
+           HexComplex* used = nullptr) {
+  const auto t = std::chrono::steady_clock::now();
   PillowResult pillowed = run_pillow(surface, complex, pillow, ctx);
+  r.timings.pillow_s = seconds_since(t);
+  embed_pillowed(surface, std::move(pillowed), params, ctx, r, used);
+}
+
+/// embed() after its pillow: r's pillow and forced from `pillowed`, then the rest.
+void embed_pillowed(const QuadSurface& surface, PillowResult pillowed, const MeshParams& params,
+                    const Context& ctx, MeshResult& r, HexComplex* used) {
   r.pillow = pillowed.stats;
   r.forced = std::move(pillowed.forced);
-  r.timings.pillow_s = seconds_since(t);
   if (!pillowed.status.ok()) {
     r.status = pillowed.status;
     return;
   }
 
-  t = std::chrono::steady_clock::now();
+  auto t = std::chrono::steady_clock::now();
   PlacementResult placed = run_placement(surface, pillowed.complex, params.placement, ctx);
   r.placement = placed.stats;
   r.timings.placement_s = seconds_since(t);
@@ -75,6 +85,7 @@ void embed(const QuadSurface& surface, const HexComplex& complex, const MeshPara
     return;
   }
   r.mesh = renumber(placed.mesh, pillowed.complex, surface.num_points());
+  if (used) *used = std::move(pillowed.complex);
 
   if (params.untangle.untangle || params.untangle.optimize) {
     t = std::chrono::steady_clock::now();
@@ -110,7 +121,7 @@ double embedding_seconds(const MeshTimings& t) {
 /// mean falls). Not when the whole boundary was pillowed (the retry would pillow it again), when
 /// the minimum is within the band of 1, and when no more corners count as forced.
 void retry_pillow(const QuadSurface& surface, const HexComplex& complex, const MeshParams& params,
-                  const Context& ctx, MeshResult& r) {
+                  const Context& ctx, MeshResult& r, HexComplex& used) {
   if (params.pillow.mode != PillowMode::automatic || !(params.pillow_retry_band > 0.0) ||
       !params.untangle.untangle || !params.untangle.optimize || r.pillow.whole_boundary)
     return;
@@ -131,7 +142,8 @@ void retry_pillow(const QuadSurface& surface, const HexComplex& complex, const M
                 r.quality.sj_min, pillow.forced_sj);
   ctx.info(msg);
   MeshResult retry;
-  embed(surface, complex, params, pillow, ctx, retry);
+  HexComplex retry_used;
+  embed(surface, complex, params, pillow, ctx, retry, &retry_used);
   PillowRetryStats s;
   s.tried = true;
   s.forced_sj = pillow.forced_sj;
@@ -164,10 +176,81 @@ void retry_pillow(const QuadSurface& surface, const HexComplex& complex, const M
     r.timings.untangle_s = retry.timings.untangle_s;
     r.timings.quality_s = retry.timings.quality_s;
     r.timings.pillow_retry_s = embedding_seconds(first);
+    used = std::move(retry_used);
   } else {
     r.timings.pillow_retry_s = embedding_seconds(retry.timings);
   }
   r.pillow_retry = s;
+}
+
+/// MeshParams::repair_rounds: while r keeps hexes with SJ <= 0 after untangling, pillows the
+/// complex r was embedded from (`used`) once more, locally around those hexes
+/// (PillowParams::seed_hexes, local_only), embeds that from a new placement and keeps it when
+/// fewer hexes stay <= 0; the rounds stop at the first that does not lower the count, or whose
+/// pillow finds no shrink set. r's pillow stats stay the first pillow's; pillow_repair says
+/// what the rounds did.
+void repair_pillow(const QuadSurface& surface, HexComplex used, const MeshParams& params,
+                   const Context& ctx, MeshResult& r) {
+  if (params.repair_rounds <= 0 || params.pillow.mode == PillowMode::none ||
+      !params.untangle.untangle || r.quality.sj_count_nonpositive == 0)
+    return;
+  PillowRetryStats& s = r.pillow_repair;
+  s.tried = true;
+  s.forced_sj = -1.0;
+  s.first_hexes = r.quality.hexes;
+  s.first_min_sj = r.quality.sj_min;
+  s.first_mean_sj = r.quality.sj_mean;
+  s.first_nonpositive = r.quality.sj_count_nonpositive;
+  // A silent pillow: a set that gives no ball ends the rounds, it is not a warning.
+  Context quiet = ctx;
+  quiet.log = nullptr;
+  for (int round = 0; round < params.repair_rounds && r.quality.sj_count_nonpositive > 0;
+       ++round) {
+    PillowParams pillow = params.pillow;
+    pillow.mode = PillowMode::automatic;
+    pillow.local_only = true;
+    pillow.forced_sj = -1.0;  // the first pillow's leftovers stay; the inverted hexes seed it
+    for (int32_t h = 0; h < static_cast<int32_t>(r.quality.per_hex_sj.size()); ++h)
+      if (!(r.quality.per_hex_sj[h] > 0.0)) pillow.seed_hexes.push_back(h);
+    auto t = std::chrono::steady_clock::now();
+    PillowResult pillowed = run_pillow(surface, used, pillow, quiet);
+    const double pillow_s = seconds_since(t);
+    if (!pillowed.status.ok() || pillowed.stats.new_hexes == 0) {
+      r.timings.pillow_retry_s += pillow_s;
+      break;
+    }
+    ctx.info(std::to_string(pillow.seed_hexes.size()) + " hexes stay inverted: " +
+             std::to_string(pillowed.stats.new_hexes) +
+             " pillow hexes around them, untangling again");
+    HexComplex next = pillowed.complex;
+    MeshResult repaired;
+    repaired.timings.pillow_s = pillow_s;
+    embed_pillowed(surface, std::move(pillowed), params, ctx, repaired, nullptr);
+    ++s.rounds;
+    if (!repaired.status.ok() ||
+        repaired.quality.sj_count_nonpositive >= r.quality.sj_count_nonpositive) {
+      r.timings.pillow_retry_s += embedding_seconds(repaired.timings);
+      break;
+    }
+    s.kept = true;
+    ++s.rounds_kept;
+    s.seed_hexes += static_cast<int32_t>(pillow.seed_hexes.size());
+    s.new_hexes += repaired.pillow.new_hexes;
+    r.timings.pillow_retry_s += r.timings.placement_s + r.timings.untangle_s + r.timings.quality_s;
+    r.timings.pillow_s += repaired.timings.pillow_s;
+    r.timings.placement_s = repaired.timings.placement_s;
+    r.timings.untangle_s = repaired.timings.untangle_s;
+    r.timings.quality_s = repaired.timings.quality_s;
+    r.placement = repaired.placement;
+    r.untangle = repaired.untangle;
+    r.mesh = std::move(repaired.mesh);
+    r.quality = std::move(repaired.quality);
+    used = std::move(next);
+  }
+  s.retry_hexes = r.quality.hexes;
+  s.retry_min_sj = r.quality.sj_min;
+  s.retry_mean_sj = r.quality.sj_mean;
+  s.retry_nonpositive = r.quality.sj_count_nonpositive;
 }
 
 /// The stages after the input checks, with elimination order `order`; fills everything but
@@ -237,8 +320,10 @@ MeshResult mesh_with_order(const SurfaceDiagnosis& diagnosis, const MeshParams& 
     return r;
   }
 
-  embed(surface, rec.complex, params, params.pillow, ctx, r);
-  if (r.status.ok()) retry_pillow(surface, rec.complex, params, ctx, r);
+  HexComplex used;
+  embed(surface, rec.complex, params, params.pillow, ctx, r, &used);
+  if (r.status.ok()) retry_pillow(surface, rec.complex, params, ctx, r, used);
+  if (r.status.ok()) repair_pillow(surface, std::move(used), params, ctx, r);
   return r;
 }
 
@@ -518,20 +603,30 @@ nlohmann::json to_json(const MeshResult& r) {
                    {"new_vertices", p.new_vertices},
                    {"whole_boundary", p.whole_boundary},
                    {"passes", p.passes}};
-    const PillowRetryStats& pr = r.pillow_retry;
-    j["pillow_retry"] = {{"tried", pr.tried}, {"kept", pr.kept}};
-    if (pr.tried) {
-      j["pillow_retry"]["forced_sj"] = pr.forced_sj;
-      j["pillow_retry"]["forced_min_sj"] = pr.forced_min_sj;
-      j["pillow_retry"]["first"] = {{"hexes", pr.first_hexes},
-                                    {"min_sj", pr.first_min_sj},
-                                    {"mean_sj", pr.first_mean_sj},
-                                    {"nonpositive", pr.first_nonpositive}};
-      j["pillow_retry"]["retry"] = {{"hexes", pr.retry_hexes},
-                                    {"min_sj", pr.retry_min_sj},
-                                    {"mean_sj", pr.retry_mean_sj},
-                                    {"nonpositive", pr.retry_nonpositive}};
-    }
+    auto retry_json = [](const PillowRetryStats& pr, bool repair) {
+      nlohmann::json o = {{"tried", pr.tried}, {"kept", pr.kept}};
+      if (!pr.tried) return o;
+      if (repair) {
+        o["rounds"] = pr.rounds;
+        o["rounds_kept"] = pr.rounds_kept;
+        o["seed_hexes"] = pr.seed_hexes;
+        o["new_hexes"] = pr.new_hexes;
+      } else {
+        o["forced_sj"] = pr.forced_sj;
+        o["forced_min_sj"] = pr.forced_min_sj;
+      }
+      o["first"] = {{"hexes", pr.first_hexes},
+                    {"min_sj", pr.first_min_sj},
+                    {"mean_sj", pr.first_mean_sj},
+                    {"nonpositive", pr.first_nonpositive}};
+      o["retry"] = {{"hexes", pr.retry_hexes},
+                    {"min_sj", pr.retry_min_sj},
+                    {"mean_sj", pr.retry_mean_sj},
+                    {"nonpositive", pr.retry_nonpositive}};
+      return o;
+    };
+    j["pillow_retry"] = retry_json(r.pillow_retry, false);
+    j["pillow_repair"] = retry_json(r.pillow_repair, true);
     const UntangleStats& u = r.untangle;
     auto phase = [](const UntanglePhaseStats& s) {
       return nlohmann::json{{"rounds", s.rounds},

@@ -529,9 +529,15 @@ TEST_F(Cli, PillowRetryBandOption) {
   EXPECT_FALSE(off.at("pillow_retry").at("tried").get<bool>());
   EXPECT_GT(on.at("scaled_jacobian").at("min").get<double>(),
             off.at("scaled_jacobian").at("min").get<double>() + 0.3);
-  const Outcome bad = run({"mesh", in, "-o", path("c.vtk"), "--pillow-retry-band", "1.5"});
-  EXPECT_EQ(bad.exit_code, 1) << bad.err;
-  EXPECT_FALSE(fs::exists(path("c.vtk")));
+  EXPECT_FALSE(on.at("pillow_repair").at("tried").get<bool>());  // every hex positive at once
+  for (std::vector<std::string> bad_arg : {std::vector<std::string>{"--pillow-retry-band", "1.5"},
+                                           {"--repair-rounds", "-1"}, {"--repair-rounds", "21"}}) {
+    std::vector<std::string> args{"mesh", in, "-o", path("c.vtk")};
+    args.insert(args.end(), bad_arg.begin(), bad_arg.end());
+    const Outcome bad = run(args);
+    EXPECT_EQ(bad.exit_code, 1) << bad.err;
+    EXPECT_FALSE(fs::exists(path("c.vtk")));
+  }
 }
 
 // --regularization: a weaker size term in the passes raises this solid's minimum (measured:
