@@ -190,11 +190,14 @@ int cmd_mesh(const std::string& in, const std::string& out, const std::string& r
     if (r.pillow_retry.tried) {
       const PillowRetryStats& pr = r.pillow_retry;
       std::printf("pillow retry (the minimum was a corner fixed by the boundary, %.4f): corners up "
-                  "to %.4f pillowed, %d hexes min %.4f mean %.4f against %d hexes min %.4f mean "
-                  "%.4f; %s kept\n",
-                  pr.forced_min_sj, pr.forced_sj, pr.retry_hexes, pr.retry_min_sj, pr.retry_mean_sj,
-                  pr.first_hexes, pr.first_min_sj, pr.first_mean_sj,
-                  pr.kept ? "the retry" : "the first mesh");
+                  "to %.4f pillowed, ", pr.forced_min_sj, pr.forced_sj);
+      if (pr.retry_ok)
+        std::printf("%d hexes min %.4f mean %.4f", pr.retry_hexes, pr.retry_min_sj,
+                    pr.retry_mean_sj);
+      else
+        std::printf("failed");
+      std::printf(" against %d hexes min %.4f mean %.4f; %s kept\n", pr.first_hexes,
+                  pr.first_min_sj, pr.first_mean_sj, pr.kept ? "the retry" : "the first mesh");
     }
     if (r.pillow_repair.tried) {
       const PillowRetryStats& pr = r.pillow_repair;

@@ -69,20 +69,22 @@ struct PillowParams {
   /// previous one had to keep out of S (at a saddle vertex), giving that vertex another copy; it
   /// is kept only when it lowers the count of forced corners and unserved vertices.
   int max_passes = 3;
-  /// Hexes of the complex pillowed as the forced ones are (in mode auto the local shrink set
-  /// grows from them and from the forced hexes alike; they make a pillow wanted even with no
-  /// forced configuration). The pipeline's repair pillow passes the hexes an embedding left
-  /// inverted (MeshParams::repair_pillow). Ids out of range are ignored.
+  /// Hexes of the complex pillowed as the forced ones are: in mode auto the local shrink set
+  /// grows from them and from the forced hexes alike, and they make a pillow wanted even with no
+  /// forced configuration. Ids out of range are ignored.
   std::vector<int32_t> seed_hexes;
-  /// Never pillow the whole boundary, even where the local set is large or leaves defects (the
-  /// repair pillow: the boundary has its layer already).
-  bool local_only = false;
+  /// Pillow around seed_hexes alone, in any mode (the repair pillow of the pipeline,
+  /// MeshParams::repair_rounds, whose boundary has its layer already): the forced configurations
+  /// are not pillowed, the whole boundary never is, and there is one pass. Each seed's set
+  /// (grown by `grow` rings) joins S, in the order given, only while S still pillows to a ball;
+  /// seeds that end inside the fitted S are not tried again.
+  bool seeds_only = false;
 };
 
 struct PillowStats {
   int32_t forced = 0;               ///< forced configurations found before pillowing
   int32_t flat_doublets = 0, concave_corners = 0, fixed_corners = 0, collinear = 0;
-  int32_t seed_hexes = 0;           ///< PillowParams::seed_hexes in range
+  int32_t seed_hexes = 0;           ///< PillowParams::seed_hexes in range (distinct)
   int32_t forced_after = 0;         ///< forced configurations left after pillowing
   int32_t excluded_vertices = 0;    ///< boundary vertices with no strictly inward direction
   int32_t dropped_hexes = 0;        ///< hexes kept out of S so every copy has an inward direction

@@ -65,14 +65,14 @@ struct MeshTimings {
                               ///< not kept by the pillow retry and the repair pillow
 };
 /// The pillow retry (MeshParams::pillow_retry_band) or the repair pillow
-/// (MeshParams::repair_pillow) of the order kept.
+/// (MeshParams::repair_rounds) of the order kept.
 struct PillowRetryStats {
   bool tried = false;        ///< retry: the minimum was a forced corner's and the retry pillowed
                              ///< more; repair: hexes stayed <= 0
   bool kept = false;         ///< the retried (repaired) mesh is the one returned
-  double forced_sj = 0.0;    ///< the retry's PillowParams::forced_sj (repair: -1, seeds only)
+  double forced_sj = 0.0;    ///< retry: its PillowParams::forced_sj
   double forced_min_sj = 0.0;  ///< retry: the forced corner bound that set it off
-  int32_t seed_hexes = 0;    ///< repair: the hexes <= 0 the rounds kept pillowed around
+  int32_t seed_hexes = 0;    ///< repair: the hexes <= 0 given as seeds to the rounds kept
   int32_t new_hexes = 0;     ///< repair: hexes the pillows of the rounds kept added
   int32_t rounds = 0;        ///< repair: rounds embedded (a pillow that found no set is none)
   int32_t rounds_kept = 0;   ///< repair: rounds kept
@@ -81,6 +81,8 @@ struct PillowRetryStats {
   double first_min_sj = 0.0, first_mean_sj = 0.0;  ///< quality of the first mesh
   double retry_min_sj = 0.0, retry_mean_sj = 0.0;  ///< ... and of the retried one
   int32_t first_nonpositive = 0, retry_nonpositive = 0;
+  bool retry_ok = false;     ///< the retry embedded (its retry_* figures are set; else null
+                             ///< in the JSON)
 };
 
 /// One elimination order the pipeline tried and what it gave.
@@ -135,7 +137,7 @@ bool better_result(const MeshResult& a, const MeshResult& b);
 MeshResult run_mesh(const PolygonSoup& soup, const MeshParams& params = {}, const Context& ctx = {});
 
 /// The report: the quality JSON plus "status", "message", "input", "chords", "steps", "plan",
-/// "reconstruction", "pillow", "pillow_retry", "placement", "untangle", "timings_s", "method" {name, side_rule,
+/// "reconstruction", "pillow", "pillow_retry", "pillow_repair", "placement", "untangle", "timings_s", "method" {name, side_rule,
 /// rules}, "orders_tried" [{method, side_rule, status, hexes, nonpositive, min_sj, seconds,
 /// same_plan_as, kept}].
 nlohmann::json to_json(const MeshResult& result);

@@ -374,6 +374,7 @@ struct PillowPass {
   int32_t set_size = 0, new_hexes = 0, new_vertices = 0, forced_after = 0, dropped = 0;
   int32_t unserved = 0;  ///< boundary vertices whose copy has no inward direction
   bool whole = false;
+  std::vector<uint8_t> set;  ///< S as pillowed (after the fit to the boundary)
   int32_t defects() const { return forced_after + unserved; }
 };
 
@@ -407,6 +408,7 @@ bool pillow_once(const QuadSurface& surface, const HexComplex& complex,
       c.forced_after = static_cast<int32_t>(
           find_forced_configurations(surface, c.complex, params.forced_sj).size());
       c.unserved = count_unserved(corners, in_s);
+      c.set = std::move(in_s);
       *res = std::move(c);
       return true;
     }
@@ -423,13 +425,14 @@ bool pillow_once(const QuadSurface& surface, const HexComplex& complex,
     return in_s;
   };
   bool have = false;
-  if (local && params.local_only) {
-    // The repair pillow: the grown forced hexes together may not be a ball (two of them meeting
-    // in an edge); each forced hex's grown set joins S only if S stays one that pillows to a
-    // ball, in the order given.
-    std::vector<uint8_t> in_s(nh, 0);
+  if (params.seeds_only) {
+    // The repair pillow: the grown seeds together may not be a ball (two of them meeting in an
+    // edge), so each seed's grown set joins S only if S stays one that pillows to a ball, in the
+    // order given. A seed inside the fitted S so far is served already.
+    std::vector<uint8_t> in_s(nh, 0), tried(nh, 0);
     for (const ForcedConfiguration& f : forced) {
-      if (in_s[f.hex]) continue;
+      if (tried[f.hex] || (have && out->set[f.hex])) continue;
+      tried[f.hex] = 1;
       std::vector<uint8_t> one(nh, 0);
       one[f.hex] = 1;
       std::vector<uint8_t> candidate = grown(std::move(one));
@@ -486,15 +489,20 @@ PillowResult run_pillow(const QuadSurface& surface, const HexComplex& complex,
     if (f.kind == ForcedKind::collinear) ++st.collinear;
   }
   st.forced_after = st.forced;
-  // Seed hexes join the first pass's forced hexes (pillow_once reads only their hex ids).
-  std::vector<ForcedConfiguration> forced = res.forced;
+  // Seed hexes join the first pass's forced hexes, or stand alone with seeds_only (pillow_once
+  // reads only their hex ids).
+  std::vector<ForcedConfiguration> forced;
+  if (!params.seeds_only) forced = res.forced;
+  std::vector<uint8_t> seeded(complex.hexes.size(), 0);
   for (int32_t h : params.seed_hexes)
-    if (h >= 0 && h < static_cast<int32_t>(complex.hexes.size())) {
+    if (h >= 0 && h < static_cast<int32_t>(complex.hexes.size()) && !seeded[h]) {
+      seeded[h] = 1;
       forced.push_back({h, -1, ForcedKind::fixed_corner, 0.0});
       ++st.seed_hexes;
     }
-  const bool want = params.mode == PillowMode::all ||
-                    (params.mode == PillowMode::automatic && !forced.empty());
+  const bool want = params.seeds_only ? !forced.empty()
+                                      : params.mode == PillowMode::all ||
+                                            (params.mode == PillowMode::automatic && !forced.empty());
   if (!want || complex.hexes.empty()) {
     st.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return res;
@@ -508,15 +516,15 @@ PillowResult run_pillow(const QuadSurface& surface, const HexComplex& complex,
   int32_t defects = st.forced;
   int32_t unserved = 0;  // copies without an inward direction, summed over the passes kept
   const int max_passes = std::max(1, params.max_passes);
-  for (int pass = 0; pass < max_passes && (pass == 0 || !forced.empty()); ++pass) {
+  for (int pass = 0; pass < max_passes && (pass == 0 || (!forced.empty() && !params.seeds_only));
+       ++pass) {
     PillowPass p;
     const bool local = params.mode == PillowMode::automatic || pass > 0;
     if (pass > 0) {  // the complex changed: its faces and boundary corners with it
       nb = face_neighbours(res.complex.hexes);
       corners = boundary_corners(surface, res.complex, nb);
     }
-    if (!pillow_once(surface, res.complex, nb, corners, forced, params, local,
-                     pass == 0 && !params.local_only, &p)) {
+    if (!pillow_once(surface, res.complex, nb, corners, forced, params, local, pass == 0, &p)) {
       if (pass == 0) ctx.warn("pillow: no shrink set gave a ball complex; the mesh is not pillowed");
       break;
     }

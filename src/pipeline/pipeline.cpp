@@ -115,6 +115,20 @@ double embedding_seconds(const MeshTimings& t) {
   return t.pillow_s + t.placement_s + t.untangle_s + t.quality_s;
 }
 
+/// The hex count, min / mean SJ and hexes <= 0 of q as a retry's first (or retried) mesh.
+void record_first(PillowRetryStats& s, const QualityReport& q) {
+  s.first_hexes = q.hexes;
+  s.first_min_sj = q.sj_min;
+  s.first_mean_sj = q.sj_mean;
+  s.first_nonpositive = q.sj_count_nonpositive;
+}
+void record_retry(PillowRetryStats& s, const QualityReport& q) {
+  s.retry_hexes = q.hexes;
+  s.retry_min_sj = q.sj_min;
+  s.retry_mean_sj = q.sj_mean;
+  s.retry_nonpositive = q.sj_count_nonpositive;
+}
+
 /// MeshParams::pillow_retry_band: when r's minimum is held by a forced corner, embeds `complex`
 /// again with a pillow that also counts the corners up to the band above the minimum as forced,
 /// and keeps what is better (fewer hexes <= 0; or as many and a minimum raised by more than the
@@ -130,17 +144,21 @@ void retry_pillow(const QuadSurface& surface, const HexComplex& complex, const M
   if (!(r.untangle.forced_min_sj <= r.quality.sj_min + 1e-9)) return;
   // Within the band of a perfect hex (a voxel solid meshed by its cubes) there is nothing to win.
   if (r.quality.sj_min + params.pillow_retry_band >= 1.0) return;
+  const auto t0 = std::chrono::steady_clock::now();
   PillowParams pillow = params.pillow;
   pillow.forced_sj = std::max(params.pillow.forced_sj, r.quality.sj_min + params.pillow_retry_band);
   if (find_forced_configurations(surface, complex, pillow.forced_sj).size() ==
-      find_forced_configurations(surface, complex, params.pillow.forced_sj).size())
+      find_forced_configurations(surface, complex, params.pillow.forced_sj).size()) {
+    r.timings.pillow_retry_s += seconds_since(t0);
     return;  // nothing more counts as forced: the same pillow
+  }
   char msg[160];
   std::snprintf(msg, sizeof msg,
                 "the minimum scaled Jacobian (%.4f) is a corner fixed by the boundary: pillowing "
                 "again with corners up to %.4f counted as forced",
                 r.quality.sj_min, pillow.forced_sj);
   ctx.info(msg);
+  const double check_s = seconds_since(t0);  // the two scans above
   MeshResult retry;
   HexComplex retry_used;
   embed(surface, complex, params, pillow, ctx, retry, &retry_used);
@@ -148,20 +166,15 @@ void retry_pillow(const QuadSurface& surface, const HexComplex& complex, const M
   s.tried = true;
   s.forced_sj = pillow.forced_sj;
   s.forced_min_sj = r.untangle.forced_min_sj;
-  s.first_hexes = r.quality.hexes;
-  s.first_min_sj = r.quality.sj_min;
-  s.first_mean_sj = r.quality.sj_mean;
-  s.first_nonpositive = r.quality.sj_count_nonpositive;
+  record_first(s, r.quality);
   if (retry.status.ok()) {
-    s.retry_hexes = retry.quality.hexes;
-    s.retry_min_sj = retry.quality.sj_min;
-    s.retry_mean_sj = retry.quality.sj_mean;
-    s.retry_nonpositive = retry.quality.sj_count_nonpositive;
+    s.retry_ok = true;
+    record_retry(s, retry.quality);
     const double gain = retry.quality.sj_min - r.quality.sj_min;
     const double loss = r.quality.sj_mean - retry.quality.sj_mean;
     s.kept = s.retry_nonpositive != s.first_nonpositive
                  ? s.retry_nonpositive < s.first_nonpositive
-                 : gain > 0.0 && gain >= loss;
+                 : gain > 0.0 && gain > loss;
   }
   const MeshTimings first = r.timings;
   if (s.kept) {
@@ -175,17 +188,17 @@ void retry_pillow(const QuadSurface& surface, const HexComplex& complex, const M
     r.timings.placement_s = retry.timings.placement_s;
     r.timings.untangle_s = retry.timings.untangle_s;
     r.timings.quality_s = retry.timings.quality_s;
-    r.timings.pillow_retry_s = embedding_seconds(first);
+    r.timings.pillow_retry_s += check_s + embedding_seconds(first);
     used = std::move(retry_used);
   } else {
-    r.timings.pillow_retry_s = embedding_seconds(retry.timings);
+    r.timings.pillow_retry_s += check_s + embedding_seconds(retry.timings);
   }
   r.pillow_retry = s;
 }
 
 /// MeshParams::repair_rounds: while r keeps hexes with SJ <= 0 after untangling, pillows the
 /// complex r was embedded from (`used`) once more, locally around those hexes
-/// (PillowParams::seed_hexes, local_only), embeds that from a new placement and keeps it when
+/// (PillowParams::seed_hexes, seeds_only), embeds that from a new placement and keeps it when
 /// fewer hexes stay <= 0; the rounds stop at the first that does not lower the count, or whose
 /// pillow finds no shrink set. r's pillow stats stay the first pillow's; pillow_repair says
 /// what the rounds did.
@@ -196,22 +209,22 @@ void repair_pillow(const QuadSurface& surface, HexComplex used, const MeshParams
     return;
   PillowRetryStats& s = r.pillow_repair;
   s.tried = true;
-  s.forced_sj = -1.0;
-  s.first_hexes = r.quality.hexes;
-  s.first_min_sj = r.quality.sj_min;
-  s.first_mean_sj = r.quality.sj_mean;
-  s.first_nonpositive = r.quality.sj_count_nonpositive;
+  record_first(s, r.quality);
   // A silent pillow: a set that gives no ball ends the rounds, it is not a warning.
   Context quiet = ctx;
   quiet.log = nullptr;
   for (int round = 0; round < params.repair_rounds && r.quality.sj_count_nonpositive > 0;
        ++round) {
     PillowParams pillow = params.pillow;
-    pillow.mode = PillowMode::automatic;
-    pillow.local_only = true;
-    pillow.forced_sj = -1.0;  // the first pillow's leftovers stay; the inverted hexes seed it
-    for (int32_t h = 0; h < static_cast<int32_t>(r.quality.per_hex_sj.size()); ++h)
-      if (!(r.quality.per_hex_sj[h] > 0.0)) pillow.seed_hexes.push_back(h);
+    pillow.seeds_only = true;  // the first pillow's leftovers stay; the inverted hexes seed it
+    const std::vector<double>& sj = r.quality.per_hex_sj;
+    for (int32_t h = 0; h < static_cast<int32_t>(sj.size()); ++h)
+      if (!(sj[h] > 0.0)) pillow.seed_hexes.push_back(h);
+    // The worst first: their sets join S first when not all of them can.
+    std::sort(pillow.seed_hexes.begin(), pillow.seed_hexes.end(), [&](int32_t a, int32_t b) {
+      const double sa = std::isnan(sj[a]) ? -2.0 : sj[a], sb = std::isnan(sj[b]) ? -2.0 : sj[b];
+      return sa != sb ? sa < sb : a < b;
+    });
     auto t = std::chrono::steady_clock::now();
     PillowResult pillowed = run_pillow(surface, used, pillow, quiet);
     const double pillow_s = seconds_since(t);
@@ -222,10 +235,10 @@ void repair_pillow(const QuadSurface& surface, HexComplex used, const MeshParams
     ctx.info(std::to_string(pillow.seed_hexes.size()) + " hexes stay inverted: " +
              std::to_string(pillowed.stats.new_hexes) +
              " pillow hexes around them, untangling again");
-    HexComplex next = pillowed.complex;
+    HexComplex next;
     MeshResult repaired;
     repaired.timings.pillow_s = pillow_s;
-    embed_pillowed(surface, std::move(pillowed), params, ctx, repaired, nullptr);
+    embed_pillowed(surface, std::move(pillowed), params, ctx, repaired, &next);
     ++s.rounds;
     if (!repaired.status.ok() ||
         repaired.quality.sj_count_nonpositive >= r.quality.sj_count_nonpositive) {
@@ -234,7 +247,7 @@ void repair_pillow(const QuadSurface& surface, HexComplex used, const MeshParams
     }
     s.kept = true;
     ++s.rounds_kept;
-    s.seed_hexes += static_cast<int32_t>(pillow.seed_hexes.size());
+    s.seed_hexes += repaired.pillow.seed_hexes;
     s.new_hexes += repaired.pillow.new_hexes;
     r.timings.pillow_retry_s += r.timings.placement_s + r.timings.untangle_s + r.timings.quality_s;
     r.timings.pillow_s += repaired.timings.pillow_s;
@@ -247,10 +260,8 @@ void repair_pillow(const QuadSurface& surface, HexComplex used, const MeshParams
     r.quality = std::move(repaired.quality);
     used = std::move(next);
   }
-  s.retry_hexes = r.quality.hexes;
-  s.retry_min_sj = r.quality.sj_min;
-  s.retry_mean_sj = r.quality.sj_mean;
-  s.retry_nonpositive = r.quality.sj_count_nonpositive;
+  record_retry(s, r.quality);
+  s.retry_ok = true;
 }
 
 /// The stages after the input checks, with elimination order `order`; fills everything but
@@ -619,10 +630,11 @@ nlohmann::json to_json(const MeshResult& r) {
                     {"min_sj", pr.first_min_sj},
                     {"mean_sj", pr.first_mean_sj},
                     {"nonpositive", pr.first_nonpositive}};
-      o["retry"] = {{"hexes", pr.retry_hexes},
-                    {"min_sj", pr.retry_min_sj},
-                    {"mean_sj", pr.retry_mean_sj},
-                    {"nonpositive", pr.retry_nonpositive}};
+      o["retry"] = pr.retry_ok ? nlohmann::json{{"hexes", pr.retry_hexes},
+                                                {"min_sj", pr.retry_min_sj},
+                                                {"mean_sj", pr.retry_mean_sj},
+                                                {"nonpositive", pr.retry_nonpositive}}
+                               : nlohmann::json(nullptr);
       return o;
     };
     j["pillow_retry"] = retry_json(r.pillow_retry, false);
