@@ -39,8 +39,8 @@ struct MeshParams {
   /// complex is pillowed once more, locally around those hexes (each grown by PillowParams::grow
   /// rings and added while the set still pillows to a ball, fitted to the boundary like any
   /// shrink set), placed and untangled again; a round is kept when fewer hexes stay <= 0, and
-  /// the rounds stop at the first that is not. Before other elimination orders are tried; not
-  /// with --pillow none or --no-untangle.
+  /// the rounds stop at the first that is not. The last resort: on the mesh kept after the
+  /// other elimination orders were tried; not with --pillow none or --no-untangle.
   int repair_rounds = 3;
   PlacementParams placement;
   UntangleParams untangle;        ///< untangling and quality optimization, after placement
@@ -117,6 +117,8 @@ struct MeshResult {
   PlacementStats placement;
   UntangleStats untangle;
   HexMesh mesh;                  ///< when status ok: boundary vertices first, in input order
+  HexComplex complex;            ///< when status ok: the (pillowed) complex mesh was placed from,
+                                 ///< hexes in the same order, its own vertex ids
   QualityReport quality;         ///< when status ok
   QuadSurface stuck_surface;     ///< when elimination got stuck: the surface it stopped at
   MeshTimings timings;

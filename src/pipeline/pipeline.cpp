@@ -197,16 +197,17 @@ void retry_pillow(const QuadSurface& surface, const HexComplex& complex, const M
 }
 
 /// MeshParams::repair_rounds: while r keeps hexes with SJ <= 0 after untangling, pillows the
-/// complex r was embedded from (`used`) once more, locally around those hexes
+/// complex r was embedded from (r.complex, which follows the rounds kept) once more, locally around those hexes
 /// (PillowParams::seed_hexes, seeds_only), embeds that from a new placement and keeps it when
 /// fewer hexes stay <= 0; the rounds stop at the first that does not lower the count, or whose
 /// pillow finds no shrink set. r's pillow stats stay the first pillow's; pillow_repair says
 /// what the rounds did.
-void repair_pillow(const QuadSurface& surface, HexComplex used, const MeshParams& params,
-                   const Context& ctx, MeshResult& r) {
-  if (params.repair_rounds <= 0 || params.pillow.mode == PillowMode::none ||
-      !params.untangle.untangle || r.quality.sj_count_nonpositive == 0)
+void repair_pillow(const QuadSurface& surface, const MeshParams& params, const Context& ctx,
+                   MeshResult& r) {
+  if (!r.status.ok() || params.repair_rounds <= 0 || params.pillow.mode == PillowMode::none ||
+      !params.untangle.untangle || r.quality.sj_count_nonpositive == 0 || r.complex.hexes.empty())
     return;
+  HexComplex& used = r.complex;
   PillowRetryStats& s = r.pillow_repair;
   s.tried = true;
   record_first(s, r.quality);
@@ -334,7 +335,7 @@ MeshResult mesh_with_order(const SurfaceDiagnosis& diagnosis, const MeshParams& 
   HexComplex used;
   embed(surface, rec.complex, params, params.pillow, ctx, r, &used);
   if (r.status.ok()) retry_pillow(surface, rec.complex, params, ctx, r, used);
-  if (r.status.ok()) repair_pillow(surface, std::move(used), params, ctx, r);
+  r.complex = std::move(used);
   return r;
 }
 
@@ -490,6 +491,16 @@ MeshResult run_mesh(const PolygonSoup& soup, const MeshParams& params, const Con
     } else {
       others_s += total_seconds(r.timings);
     }
+  }
+  // The repair pillow is the last resort, after the other orders: on an inverted mesh each of
+  // its rounds is a long untangling (screw2 with the original method: 141 -> 8 hexes <= 0 in
+  // 3 rounds, 12 min), where another order is often valid at once.
+  repair_pillow(diagnosis.validation.surface, params, ctx, best);
+  if (best.pillow_repair.kept) {  // the kept try's figures are those of the mesh returned
+    OrderTry& kept = tries[best.kept_try];
+    kept.hexes = best.quality.hexes;
+    kept.nonpositive = best.quality.sj_count_nonpositive;
+    kept.min_sj = best.quality.sj_min;
   }
   best.tries = std::move(tries);
   best.diagnosis = std::move(diagnosis);

@@ -955,7 +955,7 @@ TEST(GeometryPipeline, OtherOrdersRescueAMeshTheFirstOrderLeavesInverted) {
   const Generated g = testing::pillowed(testing::random_voxel_solid(6, 4, 12, 2), 6, 0.3);
   MeshParams mp;
   mp.untangle.morph_stages = 0;  // the continuation does not help here; skip its cost
-  mp.repair_rounds = 0;          // the repair pillow would fix it first (next test)
+  mp.repair_rounds = 0;          // only the orders here (the repair pillow: next test)
   MeshResult r = run_mesh(to_polygon_soup(g.surface), mp);
   ASSERT_TRUE(r.status.ok()) << to_string(r.status);
   ASSERT_GE(r.tries.size(), 2u);
@@ -977,14 +977,15 @@ TEST(GeometryPipeline, OtherOrdersRescueAMeshTheFirstOrderLeavesInverted) {
   EXPECT_FALSE(j["orders_tried"][0]["kept"].get<bool>());
 }
 
-// The same solid's first order keeps one hex at SJ -0.0016 next to the saddle: the repair pillow
-// puts a local layer around it (42 hexes) and untangles again, which leaves every hex positive
-// (measured: 0.357 / 0.643, where the other side rule's mesh has 0.324 / 0.678), so no other order
-// is tried.
+// The same solid's first order keeps one hex at SJ -0.0016 next to the saddle. With no other
+// order to try, the repair pillow puts a local layer around it (42 hexes) and untangles again,
+// which leaves every hex positive (measured: 0.357 / 0.643; the other side rule's mesh, which
+// the default settings keep, has 0.324 / 0.678).
 TEST(GeometryPipeline, RepairPillowFixesTheHexTheFirstEmbeddingLeavesInverted) {
   const Generated g = testing::pillowed(testing::random_voxel_solid(6, 4, 12, 2), 6, 0.3);
   MeshParams mp;
   mp.untangle.morph_stages = 0;
+  mp.alternatives = 0;
   MeshResult r = run_mesh(to_polygon_soup(g.surface), mp);
   ASSERT_TRUE(r.status.ok()) << to_string(r.status);
   ASSERT_TRUE(r.pillow_repair.tried);
@@ -997,7 +998,10 @@ TEST(GeometryPipeline, RepairPillowFixesTheHexTheFirstEmbeddingLeavesInverted) {
   EXPECT_EQ(r.quality.hexes, r.pillow_repair.first_hexes + r.pillow_repair.new_hexes);
   EXPECT_EQ(r.quality.sj_count_nonpositive, 0);
   EXPECT_GT(r.quality.sj_min, 0.2);
-  EXPECT_EQ(r.tries.size(), 1u);
+  ASSERT_EQ(r.tries.size(), 1u);
+  EXPECT_EQ(r.tries[0].nonpositive, 0);  // the kept try reports the repaired mesh
+  EXPECT_EQ(r.tries[0].hexes, r.quality.hexes);
+  EXPECT_EQ(r.complex.hexes.size(), r.mesh.hexes.size());
   EXPECT_TRUE(r.quality.is_ball);
   EXPECT_EQ(r.quality.boundary_matches_surface, true);
   EXPECT_GT(r.timings.pillow_retry_s, 0.0);
