@@ -129,13 +129,35 @@ void record_retry(PillowRetryStats& s, const QualityReport& q) {
   s.retry_nonpositive = q.sj_count_nonpositive;
 }
 
+/// r takes `from`'s embedding: placement, untangling, mesh and quality with their timings, and
+/// with `pillow` also its pillow stats (else from's pillow time adds to r's, whose pillow stats
+/// describe the first pillow). The time of r's embedding given up goes to pillow_retry_s.
+void adopt_embedding(MeshResult& r, MeshResult&& from, bool pillow) {
+  MeshTimings& t = r.timings;
+  t.pillow_retry_s += embedding_seconds(t) - (pillow ? 0.0 : t.pillow_s);
+  if (pillow) {
+    r.pillow = from.pillow;
+    r.forced = std::move(from.forced);
+    t.pillow_s = from.timings.pillow_s;
+  } else {
+    t.pillow_s += from.timings.pillow_s;
+  }
+  r.placement = from.placement;
+  r.untangle = from.untangle;
+  r.mesh = std::move(from.mesh);
+  r.quality = std::move(from.quality);
+  t.placement_s = from.timings.placement_s;
+  t.untangle_s = from.timings.untangle_s;
+  t.quality_s = from.timings.quality_s;
+}
+
 /// MeshParams::pillow_retry_band: when r's minimum is held by a forced corner, embeds `complex`
 /// again with a pillow that also counts the corners up to the band above the minimum as forced,
 /// and keeps what is better (fewer hexes <= 0; or as many and a minimum raised by more than the
 /// mean falls). Not when the whole boundary was pillowed (the retry would pillow it again), when
 /// the minimum is within the band of 1, and when no more corners count as forced.
 void retry_pillow(const QuadSurface& surface, const HexComplex& complex, const MeshParams& params,
-                  const Context& ctx, MeshResult& r, HexComplex& used) {
+                  const Context& ctx, MeshResult& r) {
   if (params.pillow.mode != PillowMode::automatic || !(params.pillow_retry_band > 0.0) ||
       !params.untangle.untangle || !params.untangle.optimize || r.pillow.whole_boundary)
     return;
@@ -176,22 +198,12 @@ void retry_pillow(const QuadSurface& surface, const HexComplex& complex, const M
                  ? s.retry_nonpositive < s.first_nonpositive
                  : gain > 0.0 && gain > loss;
   }
-  const MeshTimings first = r.timings;
+  r.timings.pillow_retry_s += check_s;
   if (s.kept) {
-    r.pillow = retry.pillow;
-    r.forced = std::move(retry.forced);
-    r.placement = retry.placement;
-    r.untangle = retry.untangle;
-    r.mesh = std::move(retry.mesh);
-    r.quality = std::move(retry.quality);
-    r.timings.pillow_s = retry.timings.pillow_s;
-    r.timings.placement_s = retry.timings.placement_s;
-    r.timings.untangle_s = retry.timings.untangle_s;
-    r.timings.quality_s = retry.timings.quality_s;
-    r.timings.pillow_retry_s += check_s + embedding_seconds(first);
-    used = std::move(retry_used);
+    adopt_embedding(r, std::move(retry), true);
+    r.complex = std::move(retry_used);
   } else {
-    r.timings.pillow_retry_s += check_s + embedding_seconds(retry.timings);
+    r.timings.pillow_retry_s += embedding_seconds(retry.timings);
   }
   r.pillow_retry = s;
 }
@@ -250,15 +262,7 @@ void repair_pillow(const QuadSurface& surface, const MeshParams& params, const C
     ++s.rounds_kept;
     s.seed_hexes += repaired.pillow.seed_hexes;
     s.new_hexes += repaired.pillow.new_hexes;
-    r.timings.pillow_retry_s += r.timings.placement_s + r.timings.untangle_s + r.timings.quality_s;
-    r.timings.pillow_s += repaired.timings.pillow_s;
-    r.timings.placement_s = repaired.timings.placement_s;
-    r.timings.untangle_s = repaired.timings.untangle_s;
-    r.timings.quality_s = repaired.timings.quality_s;
-    r.placement = repaired.placement;
-    r.untangle = repaired.untangle;
-    r.mesh = std::move(repaired.mesh);
-    r.quality = std::move(repaired.quality);
+    adopt_embedding(r, std::move(repaired), false);
     used = std::move(next);
   }
   record_retry(s, r.quality);
@@ -332,10 +336,8 @@ MeshResult mesh_with_order(const SurfaceDiagnosis& diagnosis, const MeshParams& 
     return r;
   }
 
-  HexComplex used;
-  embed(surface, rec.complex, params, params.pillow, ctx, r, &used);
-  if (r.status.ok()) retry_pillow(surface, rec.complex, params, ctx, r, used);
-  r.complex = std::move(used);
+  embed(surface, rec.complex, params, params.pillow, ctx, r, &r.complex);
+  if (r.status.ok()) retry_pillow(surface, rec.complex, params, ctx, r);
   return r;
 }
 

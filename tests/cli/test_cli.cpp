@@ -102,6 +102,18 @@ class Cli : public ::testing::Test {
   }
 
   std::string path(const std::string& name) const { return (dir_ / name).string(); }
+
+  /// `mesh in -o c.vtk` with each of `bad_args` is a usage error (exit 1) that writes nothing.
+  void expect_usage_errors(const std::string& in,
+                           const std::vector<std::vector<std::string>>& bad_args) {
+    for (const std::vector<std::string>& bad_arg : bad_args) {
+      std::vector<std::string> args{"mesh", in, "-o", path("c.vtk")};
+      args.insert(args.end(), bad_arg.begin(), bad_arg.end());
+      const Outcome bad = run(args);
+      EXPECT_EQ(bad.exit_code, 1) << bad.err;
+      EXPECT_FALSE(fs::exists(path("c.vtk")));
+    }
+  }
   std::string write(const std::string& name, const std::string& bytes) {
     spit(dir_ / name, bytes);
     return path(name);
@@ -402,9 +414,7 @@ TEST_F(Cli, MeanSweepCanBeSkipped) {
             jb.at("scaled_jacobian").at("mean").get<double>());
   EXPECT_GT(ja.at("untangle").at("local_moves").get<int64_t>(), 0);
   EXPECT_NE(slurp(path("a.vtk")), slurp(path("b.vtk")));
-  Outcome bad = run({"mesh", in, "-o", path("c.vtk"), "--alternatives", "4"});
-  EXPECT_EQ(bad.exit_code, 1) << bad.err;
-  EXPECT_FALSE(fs::exists(path("c.vtk")));
+  expect_usage_errors(in, {{"--alternatives", "4"}});
 }
 
 // --quality-passes: the report counts the passes; one pass gives a lower minimum on this solid,
@@ -423,9 +433,7 @@ TEST_F(Cli, QualityPassesOption) {
   EXPECT_EQ(jb.at("untangle").at("quality_passes").get<int>(), 1);
   EXPECT_GT(ja.at("scaled_jacobian").at("min").get<double>(),
             jb.at("scaled_jacobian").at("min").get<double>() + 1e-3);
-  Outcome bad = run({"mesh", in, "-o", path("c.vtk"), "--quality-passes", "0"});
-  EXPECT_EQ(bad.exit_code, 1) << bad.err;
-  EXPECT_FALSE(fs::exists(path("c.vtk")));
+  expect_usage_errors(in, {{"--quality-passes", "0"}});
 }
 
 // --final-polish-runs: the report counts the runs and whether the polish stayed; 0 skips it and
@@ -446,9 +454,7 @@ TEST_F(Cli, FinalPolishRunsOption) {
   EXPECT_FALSE(jb.at("untangle").at("final_polish_kept").get<bool>());
   EXPECT_GT(ja.at("scaled_jacobian").at("mean").get<double>(),
             jb.at("scaled_jacobian").at("mean").get<double>() + 0.005);
-  Outcome bad = run({"mesh", in, "-o", path("c.vtk"), "--final-polish-runs", "101"});
-  EXPECT_EQ(bad.exit_code, 1) << bad.err;
-  EXPECT_FALSE(fs::exists(path("c.vtk")));
+  expect_usage_errors(in, {{"--final-polish-runs", "101"}});
 }
 
 // --pillow-whole-fraction and --pillow-grow: this solid's 4 forced corners grow into a local set
@@ -473,15 +479,8 @@ TEST_F(Cli, PillowShrinkSetOptions) {
   EXPECT_FALSE(local1.at("whole_boundary").get<bool>());
   EXPECT_LT(local2.at("new_hexes").get<int>(), whole.at("new_hexes").get<int>());
   EXPECT_LT(local1.at("new_hexes").get<int>(), local2.at("new_hexes").get<int>());
-  for (std::vector<std::string> bad_arg : {std::vector<std::string>{"--pillow-grow", "11"},
-                                           {"--pillow-whole-fraction", "1.5"},
-                                           {"--pillow-margin", "-0.1"}}) {
-    std::vector<std::string> args{"mesh", in, "-o", path("c.vtk")};
-    args.insert(args.end(), bad_arg.begin(), bad_arg.end());
-    Outcome bad = run(args);
-    EXPECT_EQ(bad.exit_code, 1) << bad.err;
-    EXPECT_FALSE(fs::exists(path("c.vtk")));
-  }
+  expect_usage_errors(
+      in, {{"--pillow-grow", "11"}, {"--pillow-whole-fraction", "1.5"}, {"--pillow-margin", "-0.1"}});
 }
 
 // The stuck fill's options: the 20-quad surface no chord can leave is filled by default, fails
@@ -498,14 +497,7 @@ TEST_F(Cli, StuckFillOptions) {
   EXPECT_EQ(small.exit_code, 3) << small.err;
   EXPECT_NE(small.err.find("stuck"), std::string::npos) << small.err;
   EXPECT_FALSE(fs::exists(path("s.vtk")));
-  for (std::vector<std::string> bad_arg : {std::vector<std::string>{"--stuck-fill-quads", "0"},
-                                           {"--stuck-fill-budget", "0"}}) {
-    std::vector<std::string> args{"mesh", in, "-o", path("c.vtk")};
-    args.insert(args.end(), bad_arg.begin(), bad_arg.end());
-    const Outcome bad = run(args);
-    EXPECT_EQ(bad.exit_code, 1) << bad.err;
-    EXPECT_FALSE(fs::exists(path("c.vtk")));
-  }
+  expect_usage_errors(in, {{"--stuck-fill-quads", "0"}, {"--stuck-fill-budget", "0"}});
 }
 
 // --pillow-retry-band: the report's pillow_retry on a coarse cubed sphere whose minimum is a
@@ -530,14 +522,8 @@ TEST_F(Cli, PillowRetryBandOption) {
   EXPECT_GT(on.at("scaled_jacobian").at("min").get<double>(),
             off.at("scaled_jacobian").at("min").get<double>() + 0.3);
   EXPECT_FALSE(on.at("pillow_repair").at("tried").get<bool>());  // every hex positive at once
-  for (std::vector<std::string> bad_arg : {std::vector<std::string>{"--pillow-retry-band", "1.5"},
-                                           {"--repair-rounds", "-1"}, {"--repair-rounds", "21"}}) {
-    std::vector<std::string> args{"mesh", in, "-o", path("c.vtk")};
-    args.insert(args.end(), bad_arg.begin(), bad_arg.end());
-    const Outcome bad = run(args);
-    EXPECT_EQ(bad.exit_code, 1) << bad.err;
-    EXPECT_FALSE(fs::exists(path("c.vtk")));
-  }
+  expect_usage_errors(
+      in, {{"--pillow-retry-band", "1.5"}, {"--repair-rounds", "-1"}, {"--repair-rounds", "21"}});
 }
 
 // --regularization: a weaker size term in the passes raises this solid's minimum (measured:
@@ -552,9 +538,7 @@ TEST_F(Cli, RegularizationOption) {
     return nlohmann::json::parse(slurp(path("m.json"))).at("scaled_jacobian").at("min").get<double>();
   };
   EXPECT_GT(min_sj("0.003"), min_sj("0.01") + 0.005);
-  Outcome bad = run({"mesh", in, "-o", path("c.vtk"), "--regularization", "1.5"});
-  EXPECT_EQ(bad.exit_code, 1) << bad.err;
-  EXPECT_FALSE(fs::exists(path("c.vtk")));
+  expect_usage_errors(in, {{"--regularization", "1.5"}});
 }
 
 // A pillowed voxel solid whose reconstruction has hexes lying flat in the boundary (all 8
