@@ -105,7 +105,8 @@ int main(int argc, char** argv) {
     };
     double total = 0;
     for (const char* s : {"read", "check", "elimination", "reconstruction", "pillow", "placement",
-                          "untangle", "quality", "pillow_retry", "other_orders"})
+                          "untangle", "quality", "pillow_retry", "intrusion_cover",
+                          "other_orders"})
       total += std::isnan(num("timings_s", s)) ? 0.0 : num("timings_s", s);
     std::string hexes = meshed ? std::to_string(j.value("hexes", 0)) : "-";
     std::string minsj = meshed ? fmt(num("scaled_jacobian", "min")) : "-";

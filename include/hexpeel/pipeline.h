@@ -7,6 +7,7 @@
 #include "hexpeel/elimination.h"
 #include "hexpeel/planner.h"
 #include "hexpeel/embedding.h"
+#include "hexpeel/intrusion_cover.h"
 #include "hexpeel/pillow.h"
 #include "hexpeel/quality.h"
 #include "hexpeel/reconstruction.h"
@@ -42,6 +43,11 @@ struct MeshParams {
   /// the rounds stop at the first that is not. The last resort: on the mesh kept after the
   /// other elimination orders were tried; not with --pillow none or --no-untangle.
   int repair_rounds = 3;
+  /// When the plan's reconstruction refuses intrusions of concave steps (paper 5.4), rebuild
+  /// the plan with covering steps after its concave runs (intrusion_cover.h); when all its
+  /// intrusions go, mesh it too and keep the better mesh (better_result). Only with the search
+  /// planner.
+  bool intrusion_cover = true;
   PlacementParams placement;
   UntangleParams untangle;        ///< untangling and quality optimization, after placement
   QualityParams quality;
@@ -63,6 +69,8 @@ struct MeshTimings {
                               ///< another was kept)
   double pillow_retry_s = 0;  ///< pillow, placement, untangling and quality of the embeddings
                               ///< not kept by the pillow retry and the repair pillow
+  double intrusion_cover_s = 0;  ///< rebuilding the plan with covering steps, its
+                                 ///< reconstruction, and the embedding of the plan not kept
 };
 /// The pillow retry (MeshParams::pillow_retry_band) or the repair pillow
 /// (MeshParams::repair_rounds) of the order kept.
@@ -109,6 +117,7 @@ struct MeshResult {
   EliminationPlan plan;          ///< when the surface was valid
   PlannerStats planner;          ///< when the planner ran
   TerminalStats terminal;        ///< when elimination got stuck
+  IntrusionCoverStats intrusion_cover;
   ReconstructionStats reconstruction;
   PillowStats pillow;
   std::vector<ForcedConfiguration> forced;  ///< found after reconstruction (before pillowing)

@@ -269,6 +269,16 @@ void repair_pillow(const QuadSurface& surface, const MeshParams& params, const C
   s.retry_ok = true;
 }
 
+/// ctx, with its warnings kept in `held` instead of passed on.
+Context holding_warnings(const Context& ctx, std::vector<std::string>& held) {
+  Context c = ctx;
+  c.log = [&held, log = ctx.log](LogLevel level, std::string_view msg) {
+    if (level == LogLevel::warning) held.emplace_back(msg);
+    else if (log) log(level, msg);
+  };
+  return c;
+}
+
 /// The stages after the input checks, with elimination order `order`; fills everything but
 /// `diagnosis`, `tries` and the check time. `plans` holds the keys of the plans meshed before;
 /// when this order plans one of them again, it stops after planning and `same_as` names it.
@@ -328,16 +338,69 @@ MeshResult mesh_with_order(const SurfaceDiagnosis& diagnosis, const MeshParams& 
   if (too_large) return r;
 
   t = std::chrono::steady_clock::now();
-  ReconstructionResult rec = run_reconstruction(surface, r.plan, params.reconstruction, ctx, &state);
+  // With the cover to try, warnings wait until it is known which plan is meshed.
+  const bool may_cover = params.intrusion_cover && params.search && r.plan.stats.concave_steps > 0 &&
+                         r.plan.terminal.empty();
+  std::vector<std::string> held;
+  const Context quiet = may_cover ? holding_warnings(ctx, held) : ctx;
+  ReconstructionResult rec = run_reconstruction(surface, r.plan, params.reconstruction, quiet, &state);
   r.reconstruction = rec.stats;
   r.timings.reconstruction_s = seconds_since(t);
-  if (!rec.status.ok()) {
-    r.status = rec.status;
-    return r;
+  // Intrusions refused: the plan rebuilt with covering steps after its concave runs
+  // (intrusion_cover.h), when all its intrusions go, is meshed too, and the better mesh kept
+  // (better_result). Both are meshed because intruding is not always better: random voxel
+  // solids whose refused steps were extruded into their ideal cubes got 0.07-0.53 covered.
+  MeshResult covered;
+  bool cover = false;
+  std::vector<std::string> held_cover;
+  if (may_cover && rec.status.code != StatusCode::internal_error &&
+      !rec.stats.invalid_intrusion_steps.empty()) {
+    IntrusionCoverStats& cs = r.intrusion_cover;
+    cs.refused_before = static_cast<int32_t>(rec.stats.invalid_intrusion_steps.size());
+    cs.refused_after = -1;
+    PlannerParams pp = params.planner;
+    pp.order = order;
+    EliminationState cover_state(surface, diagnosis.chords, diagnosis.edges);
+    EliminationPlan cp = cover_concave_steps(cover_state, r.plan, pp, quiet, cs);
+    if (cp.status.ok()) {
+      const Context quiet_cover = holding_warnings(ctx, held_cover);
+      const auto tc = std::chrono::steady_clock::now();
+      ReconstructionResult rec2 = run_reconstruction(surface, cp, params.reconstruction, quiet_cover, &cover_state);
+      cs.time_s += seconds_since(tc);
+      if (rec2.status.code != StatusCode::internal_error)
+        cs.refused_after = static_cast<int32_t>(rec2.stats.invalid_intrusion_steps.size());
+      if (rec2.status.ok() && cs.refused_after == 0) {
+        cover = true;
+        covered.method = r.method;
+        covered.plan = std::move(cp);
+        covered.planner = r.planner;
+        covered.reconstruction = rec2.stats;
+        covered.timings = r.timings;
+        embed(surface, rec2.complex, params, params.pillow, quiet_cover, covered, &covered.complex);
+        if (covered.status.ok()) retry_pillow(surface, rec2.complex, params, quiet_cover, covered);
+      }
+    }
   }
-
-  embed(surface, rec.complex, params, params.pillow, ctx, r, &r.complex);
-  if (r.status.ok()) retry_pillow(surface, rec.complex, params, ctx, r);
+  if (rec.status.ok()) {
+    embed(surface, rec.complex, params, params.pillow, quiet, r, &r.complex);
+    if (r.status.ok()) retry_pillow(surface, rec.complex, params, quiet, r);
+  } else {
+    r.status = rec.status;
+  }
+  if (cover) {
+    IntrusionCoverStats& cs = r.intrusion_cover;
+    const bool keep = better_result(covered, r);
+    MeshResult& dropped = keep ? r : covered;
+    cs.time_s += embedding_seconds(dropped.timings) + dropped.timings.pillow_retry_s;
+    cs.kept = keep;
+    covered.intrusion_cover = cs;
+    if (keep) {
+      r = std::move(covered);
+      held = std::move(held_cover);
+    }
+  }
+  r.timings.intrusion_cover_s = r.intrusion_cover.time_s;
+  for (const std::string& w : held) ctx.warn(w);
   return r;
 }
 
@@ -373,7 +436,7 @@ bool refused_intrusions(const MeshResult& r, const MeshParams& params) {
 
 double total_seconds(const MeshTimings& t) {
   return t.elimination_s + t.reconstruction_s + t.pillow_s + t.placement_s + t.untangle_s +
-         t.quality_s + t.pillow_retry_s;
+         t.quality_s + t.pillow_retry_s + t.intrusion_cover_s;
 }
 
 /// A try made only for refused intrusions builds no plan of more than this many times the
@@ -593,6 +656,18 @@ nlohmann::json to_json(const MeshResult& r) {
                     {"time_s", r.planner.time_s},
                     {"first_plan_s", r.planner.first_plan_s}};
   }
+  if (r.intrusion_cover.tried) {
+    const IntrusionCoverStats& c = r.intrusion_cover;
+    j["intrusion_cover"] = {{"kept", c.kept},
+                            {"cover_steps", c.cover_steps},
+                            {"replans", c.replans},
+                            {"uncovered_quads", c.uncovered_quads},
+                            {"refused_before", c.refused_before},
+                            {"refused_after", c.refused_after < 0 ? nlohmann::json(nullptr)
+                                                                  : nlohmann::json(c.refused_after)},
+                            {"predicted_hexes", c.predicted_hexes},
+                            {"time_s", c.time_s}};
+  }
   j["reconstruction"] = {{"hexes", r.reconstruction.hexes},
                          {"slit_edges", r.reconstruction.slit_edges},
                          {"steps_verified", r.reconstruction.steps_verified},
@@ -699,6 +774,7 @@ nlohmann::json to_json(const MeshResult& r) {
                     {"untangle", r.timings.untangle_s},
                     {"quality", r.timings.quality_s},
                     {"pillow_retry", r.timings.pillow_retry_s},
+                    {"intrusion_cover", r.timings.intrusion_cover_s},
                     {"other_orders", r.timings.other_orders_s}};
   return j;
 }

@@ -526,6 +526,34 @@ TEST_F(Cli, PillowRetryBandOption) {
       in, {{"--pillow-retry-band", "1.5"}, {"--repair-rounds", "-1"}, {"--repair-rounds", "21"}});
 }
 
+// --no-intrusion-cover: this random voxel solid's plan refuses intrusions; the plan rebuilt with
+// covering steps intrudes them all and is meshed too, but the refused steps extruded give the
+// ideal cubes, so that mesh is kept (as it is without the cover).
+TEST_F(Cli, IntrusionCoverOption) {
+  const std::string in = write("rvox.obj", gen::random_voxel_solid(374, 6, 28, 1).surface);
+  auto report = [&](const std::vector<std::string>& extra) {
+    std::vector<std::string> args{"mesh", in, "-o", path("m.vtk"), "--report", path("m.json"), "-q"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const Outcome o = run(args);
+    EXPECT_EQ(o.exit_code, 0) << o.err;
+    return nlohmann::json::parse(slurp(path("m.json")));
+  };
+  const nlohmann::json on = report({}), off = report({"--no-intrusion-cover"});
+  ASSERT_TRUE(on.contains("intrusion_cover")) << on.dump();
+  const nlohmann::json& c = on.at("intrusion_cover");
+  EXPECT_GT(c.at("refused_before").get<int>(), 0);
+  EXPECT_EQ(c.at("refused_after").get<int>(), 0);
+  EXPECT_GE(c.at("cover_steps").get<int>(), 1);
+  EXPECT_FALSE(c.at("kept").get<bool>());
+  EXPECT_GT(on.at("timings_s").at("intrusion_cover").get<double>(), 0.0);
+  EXPECT_FALSE(off.contains("intrusion_cover"));
+  EXPECT_EQ(off.at("timings_s").at("intrusion_cover").get<double>(), 0.0);
+  EXPECT_EQ(on.at("hexes").get<int>(), off.at("hexes").get<int>());
+  EXPECT_EQ(on.at("scaled_jacobian").at("min").get<double>(), 1.0);
+  EXPECT_EQ(on.at("reconstruction").at("invalid_intrusion_steps"),
+            off.at("reconstruction").at("invalid_intrusion_steps"));
+}
+
 // --regularization: a weaker size term in the passes raises this solid's minimum (measured:
 // 0.4736 -> 0.4841 with 0.003); the weight is range-checked.
 TEST_F(Cli, RegularizationOption) {
