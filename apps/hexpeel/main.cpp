@@ -385,7 +385,9 @@ int main(int argc, char** argv) {
   mesh->add_option("--repair-rounds", params.repair_rounds,
                    "while hexes stay <= 0 after untangling: rounds of a local pillow around them "
                    "and untangling again, each kept only when fewer hexes stay <= 0 (the last resort, "
-                   "on the mesh kept after the other elimination orders); 0 = none")
+                   "on the mesh kept after the other elimination orders), then, if hexes still stay "
+                   "<= 0 and the first pillow was local, one round with the whole boundary "
+                   "pillowed; 0 = none")
       ->check(CLI::Range(0, 20))->capture_default_str();
   mesh->add_option("--pillow-margin", params.pillow.target_margin,
                    "inward margin (0..1, unit normals) the pillow keeps at a boundary vertex's "

@@ -40,7 +40,8 @@ struct MeshParams {
   /// complex is pillowed once more, locally around those hexes (each grown by PillowParams::grow
   /// rings and added while the set still pillows to a ball, fitted to the boundary like any
   /// shrink set), placed and untangled again; a round is kept when fewer hexes stay <= 0, and
-  /// the rounds stop at the first that is not. The last resort: on the mesh kept after the
+  /// the rounds stop at the first that is not; then, when hexes still stay <= 0 and the first
+  /// pillow was local, one more round pillows the whole boundary. The last resort: on the mesh kept after the
   /// other elimination orders were tried; not with --pillow none or --no-untangle.
   int repair_rounds = 3;
   /// When the plan's reconstruction refuses intrusions of concave steps (paper 5.4), rebuild
@@ -84,6 +85,9 @@ struct PillowRetryStats {
   int32_t new_hexes = 0;     ///< repair: hexes the pillows of the rounds kept added
   int32_t rounds = 0;        ///< repair: rounds embedded (a pillow that found no set is none)
   int32_t rounds_kept = 0;   ///< repair: rounds kept
+  bool whole = false;        ///< repair: a last round pillowed the whole boundary (the local
+                             ///< rounds left hexes <= 0 and the first pillow was local)
+  bool whole_kept = false;   ///< ... and it was kept
   int32_t first_hexes = 0, retry_hexes = 0;  ///< hexes of the two meshes (repair: before the
                                              ///< rounds and of the mesh returned)
   double first_min_sj = 0.0, first_mean_sj = 0.0;  ///< quality of the first mesh
