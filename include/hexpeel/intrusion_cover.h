@@ -43,7 +43,8 @@ struct IntrusionCoverStats {
 /// covering steps, plans the rest with run_planner(params) and goes on with the next concave run
 /// of that plan. Virtual layers no covering step is found for are left to the plan's own later
 /// steps (a later step may still lay them cleanly); after `max_replans` planner runs the rest
-/// is replayed without covers. A planner run that finds no plan gives its status. On success
+/// is replayed without covers. All replans together get params.budget_s (flat steps weighed by
+/// the input's quad count); a planner run that finds no plan, or a spent budget, gives stuck. On success
 /// `state` holds the new plan's final cube; its steps record concave and flat as the plans did.
 EliminationPlan cover_concave_steps(EliminationState& state, const EliminationPlan& plan,
                                     const PlannerParams& params, const Context& ctx,

@@ -69,6 +69,7 @@ EliminationPlan rebuild(EliminationState& state, const EliminationPlan& plan,
   size_t pos = 0;
   // Virtual layers still to be covered, per input quad (the state is fresh: all quads alive).
   std::vector<int32_t> pending(static_cast<size_t>(state.alive_quads()), 0);
+  double replan_effort = 0.0;  // budget seconds the replans used
   out.status = Status::success();
   while (true) {
     // Replay up to the end of the next run of concave steps.
@@ -76,7 +77,9 @@ EliminationPlan rebuild(EliminationState& state, const EliminationPlan& plan,
     for (; pos < todo.size(); ++pos) {
       const PlanStep& b = todo[pos];
       if (in_run && !b.concave) break;
-      if (!state.chord_alive(b.chord) || !state.feasibility(b.chord).sides[b.side]) {
+      const auto f = state.chord_alive(b.chord) ? state.feasibility(b.chord)
+                                                 : EliminationState::Feasibility{};
+      if (!state.chord_alive(b.chord) || !f.ok() || !f.sides[b.side]) {
         out.status = Status::error(StatusCode::internal_error,
                                    "intrusion cover: a step of the plan cannot be replayed");
         return out;
@@ -102,7 +105,19 @@ EliminationPlan rebuild(EliminationState& state, const EliminationPlan& plan,
     stats.cover_steps += static_cast<int32_t>(covers.size());
     for (auto& c : covers) out.steps.push_back(std::move(c));
     ++stats.replans;
-    PlannerResult rest = run_planner(state, params, ctx);
+    // The replans share the budget the whole plan has (what the first search left is not
+    // known here, so all replans together get one budget), and flat steps keep the input's
+    // penalty (the planner would take the quads left).
+    PlannerParams rp = params;
+    rp.budget_s = params.budget_s - replan_effort;
+    rp.improve_budget_s = std::min(params.improve_budget_s, rp.budget_s);
+    if (rp.flat_penalty <= 0) rp.flat_penalty = static_cast<double>(pending.size());
+    if (!(rp.budget_s > 0)) {
+      out.status = Status::error(StatusCode::stuck, "intrusion cover: the replans used up the plan budget");
+      return out;
+    }
+    PlannerResult rest = run_planner(state, rp, ctx);
+    replan_effort += rest.stats.effort_s;
     if (!rest.plan.status.ok()) {
       out.status = rest.plan.status;
       return out;

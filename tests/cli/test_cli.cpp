@@ -528,7 +528,8 @@ TEST_F(Cli, PillowRetryBandOption) {
 
 // --no-intrusion-cover: this random voxel solid's plan refuses intrusions; the plan rebuilt with
 // covering steps intrudes them all and is meshed too, but the refused steps extruded give the
-// ideal cubes, so that mesh is kept (as it is without the cover).
+// ideal cubes, so that mesh is kept (as it is without the cover). With --strict-intrusion the
+// rebuilt plan's mesh is the only one, and kept.
 TEST_F(Cli, IntrusionCoverOption) {
   const std::string in = write("rvox.obj", gen::random_voxel_solid(374, 6, 28, 1).surface);
   auto report = [&](const std::vector<std::string>& extra) {
@@ -552,6 +553,16 @@ TEST_F(Cli, IntrusionCoverOption) {
   EXPECT_EQ(on.at("scaled_jacobian").at("min").get<double>(), 1.0);
   EXPECT_EQ(on.at("reconstruction").at("invalid_intrusion_steps"),
             off.at("reconstruction").at("invalid_intrusion_steps"));
+  // --strict-intrusion stops the first reconstruction at its first refusal; the rebuilt plan,
+  // which intrudes every concave step, is then the only mesh, and it is kept.
+  const nlohmann::json strict = report({"--strict-intrusion"});
+  const nlohmann::json& sc = strict.at("intrusion_cover");
+  EXPECT_TRUE(sc.at("kept").get<bool>());
+  EXPECT_EQ(sc.at("refused_before").get<int>(), 1);
+  EXPECT_EQ(sc.at("refused_after").get<int>(), 0);
+  EXPECT_TRUE(strict.at("reconstruction").at("invalid_intrusion_steps").empty());
+  EXPECT_GT(strict.at("reconstruction").at("intrusions").get<int>(), 0);
+  EXPECT_EQ(strict.at("status").get<std::string>(), "ok");
 }
 
 // --regularization: a weaker size term in the passes raises this solid's minimum (measured:
