@@ -114,6 +114,14 @@ class Cli : public ::testing::Test {
       EXPECT_FALSE(fs::exists(path("c.vtk")));
     }
   }
+  /// `mesh in -o m.vtk --report m.json -q` with `extra`, expected to exit 0: the report.
+  nlohmann::json mesh_report(const std::string& in, const std::vector<std::string>& extra) {
+    std::vector<std::string> args{"mesh", in, "-o", path("m.vtk"), "--report", path("m.json"), "-q"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const Outcome o = run(args);
+    EXPECT_EQ(o.exit_code, 0) << o.err;
+    return nlohmann::json::parse(slurp(path("m.json")));
+  }
   std::string write(const std::string& name, const std::string& bytes) {
     spit(dir_ / name, bytes);
     return path(name);
@@ -505,13 +513,7 @@ TEST_F(Cli, StuckFillOptions) {
 // band is range-checked.
 TEST_F(Cli, PillowRetryBandOption) {
   const std::string in = write("cs4.obj", gen::cubed_sphere_equiangular(4).surface);
-  auto report = [&](const std::vector<std::string>& extra) {
-    std::vector<std::string> args{"mesh", in, "-o", path("m.vtk"), "--report", path("m.json"), "-q"};
-    args.insert(args.end(), extra.begin(), extra.end());
-    const Outcome o = run(args);
-    EXPECT_EQ(o.exit_code, 0) << o.err;
-    return nlohmann::json::parse(slurp(path("m.json")));
-  };
+  auto report = [&](const std::vector<std::string>& extra) { return mesh_report(in, extra); };
   const nlohmann::json on = report({}), off = report({"--pillow-retry-band", "0"});
   EXPECT_TRUE(on.at("pillow_retry").at("tried").get<bool>());
   EXPECT_TRUE(on.at("pillow_retry").at("kept").get<bool>());
@@ -532,13 +534,7 @@ TEST_F(Cli, PillowRetryBandOption) {
 // rebuilt plan's mesh is the only one, and kept.
 TEST_F(Cli, IntrusionCoverOption) {
   const std::string in = write("rvox.obj", gen::random_voxel_solid(374, 6, 28, 1).surface);
-  auto report = [&](const std::vector<std::string>& extra) {
-    std::vector<std::string> args{"mesh", in, "-o", path("m.vtk"), "--report", path("m.json"), "-q"};
-    args.insert(args.end(), extra.begin(), extra.end());
-    const Outcome o = run(args);
-    EXPECT_EQ(o.exit_code, 0) << o.err;
-    return nlohmann::json::parse(slurp(path("m.json")));
-  };
+  auto report = [&](const std::vector<std::string>& extra) { return mesh_report(in, extra); };
   const nlohmann::json on = report({}), off = report({"--no-intrusion-cover"});
   ASSERT_TRUE(on.contains("intrusion_cover")) << on.dump();
   const nlohmann::json& c = on.at("intrusion_cover");
