@@ -226,8 +226,39 @@ void repair_pillow(const QuadSurface& surface, const MeshParams& params, const C
   // A silent pillow: a set that gives no ball ends the rounds, it is not a warning.
   Context quiet = ctx;
   quiet.log = nullptr;
-  for (int round = 0; round < params.repair_rounds && r.quality.sj_count_nonpositive > 0;
-       ++round) {
+  // One round: pillow the complex in hand with `pillow`, place and untangle again, keep the
+  // result when fewer hexes stay <= 0. Returns whether it was kept (false also when the pillow
+  // found no set).
+  auto round = [&](const PillowParams& pillow, int64_t inverted, const char* where) {
+    auto t = std::chrono::steady_clock::now();
+    PillowResult pillowed = run_pillow(surface, used, pillow, quiet);
+    const double pillow_s = seconds_since(t);
+    if (!pillowed.status.ok() || pillowed.stats.new_hexes == 0) {
+      r.timings.pillow_retry_s += pillow_s;
+      return false;
+    }
+    ctx.info(std::to_string(inverted) + " hexes stay inverted: " +
+             std::to_string(pillowed.stats.new_hexes) + " pillow hexes " + where +
+             ", untangling again");
+    HexComplex next;
+    MeshResult repaired;
+    repaired.timings.pillow_s = pillow_s;
+    embed_pillowed(surface, std::move(pillowed), params, ctx, repaired, &next);
+    ++s.rounds;
+    if (!repaired.status.ok() ||
+        repaired.quality.sj_count_nonpositive >= r.quality.sj_count_nonpositive) {
+      r.timings.pillow_retry_s += embedding_seconds(repaired.timings);
+      return false;
+    }
+    s.kept = true;
+    ++s.rounds_kept;
+    s.seed_hexes += repaired.pillow.seed_hexes;
+    s.new_hexes += repaired.pillow.new_hexes;
+    adopt_embedding(r, std::move(repaired), false);
+    used = std::move(next);
+    return true;
+  };
+  for (int n = 0; n < params.repair_rounds && r.quality.sj_count_nonpositive > 0; ++n) {
     PillowParams pillow = params.pillow;
     pillow.seeds_only = true;  // the first pillow's leftovers stay; the inverted hexes seed it
     const std::vector<double>& sj = r.quality.per_hex_sj;
@@ -238,32 +269,7 @@ void repair_pillow(const QuadSurface& surface, const MeshParams& params, const C
       const double sa = std::isnan(sj[a]) ? -2.0 : sj[a], sb = std::isnan(sj[b]) ? -2.0 : sj[b];
       return sa != sb ? sa < sb : a < b;
     });
-    auto t = std::chrono::steady_clock::now();
-    PillowResult pillowed = run_pillow(surface, used, pillow, quiet);
-    const double pillow_s = seconds_since(t);
-    if (!pillowed.status.ok() || pillowed.stats.new_hexes == 0) {
-      r.timings.pillow_retry_s += pillow_s;
-      break;
-    }
-    ctx.info(std::to_string(pillow.seed_hexes.size()) + " hexes stay inverted: " +
-             std::to_string(pillowed.stats.new_hexes) +
-             " pillow hexes around them, untangling again");
-    HexComplex next;
-    MeshResult repaired;
-    repaired.timings.pillow_s = pillow_s;
-    embed_pillowed(surface, std::move(pillowed), params, ctx, repaired, &next);
-    ++s.rounds;
-    if (!repaired.status.ok() ||
-        repaired.quality.sj_count_nonpositive >= r.quality.sj_count_nonpositive) {
-      r.timings.pillow_retry_s += embedding_seconds(repaired.timings);
-      break;
-    }
-    s.kept = true;
-    ++s.rounds_kept;
-    s.seed_hexes += repaired.pillow.seed_hexes;
-    s.new_hexes += repaired.pillow.new_hexes;
-    adopt_embedding(r, std::move(repaired), false);
-    used = std::move(next);
+    if (!round(pillow, static_cast<int64_t>(pillow.seed_hexes.size()), "around them")) break;
   }
   // Local sets that do not help: a last round pillows the whole boundary of the complex in hand
   // (a smoothed block with a slot, no sharp edge: its local pillow and the repair's leave 8
@@ -271,33 +277,9 @@ void repair_pillow(const QuadSurface& surface, const MeshParams& params, const C
   if (r.quality.sj_count_nonpositive > 0 && !r.pillow.whole_boundary) {
     PillowParams pillow = params.pillow;
     pillow.mode = PillowMode::all;
-    auto t = std::chrono::steady_clock::now();
-    PillowResult pillowed = run_pillow(surface, used, pillow, quiet);
-    const double pillow_s = seconds_since(t);
-    if (!pillowed.status.ok() || pillowed.stats.new_hexes == 0) {
-      r.timings.pillow_retry_s += pillow_s;
-    } else {
-      ctx.info(std::to_string(r.quality.sj_count_nonpositive) + " hexes stay inverted: " +
-               std::to_string(pillowed.stats.new_hexes) +
-               " pillow hexes under the whole boundary, untangling again");
-      HexComplex next;
-      MeshResult repaired;
-      repaired.timings.pillow_s = pillow_s;
-      embed_pillowed(surface, std::move(pillowed), params, ctx, repaired, &next);
-      ++s.rounds;
-      s.whole = true;
-      if (repaired.status.ok() &&
-          repaired.quality.sj_count_nonpositive < r.quality.sj_count_nonpositive) {
-        s.kept = true;
-        s.whole_kept = true;
-        ++s.rounds_kept;
-        s.new_hexes += repaired.pillow.new_hexes;
-        adopt_embedding(r, std::move(repaired), false);
-        used = std::move(next);
-      } else {
-        r.timings.pillow_retry_s += embedding_seconds(repaired.timings);
-      }
-    }
+    const int32_t rounds_before = s.rounds;
+    s.whole_kept = round(pillow, r.quality.sj_count_nonpositive, "under the whole boundary");
+    s.whole = s.rounds > rounds_before;
   }
   record_retry(s, r.quality);
   s.retry_ok = true;
