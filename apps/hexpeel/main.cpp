@@ -87,10 +87,21 @@ Context make_context(Progress* progress, bool quiet) {
   return ctx;
 }
 
+/// A surface file that is also a volume mesh: only its faces are the surface.
+void warn_hexes_ignored(const std::string& in, int64_t hexes) {
+  if (hexes > 0)
+    std::fprintf(stderr,
+                 "hexpeel: warning: %s: %lld hexahedra ignored: only the file's faces are read as "
+                 "the surface\n",
+                 in.c_str(), static_cast<long long>(hexes));
+}
+
 int cmd_check(const std::string& in, double sharp_angle, const std::string& json_out) {
   PolygonSoup soup;
-  Status st = read_surface(in, soup);
+  int64_t hexes_ignored = 0;
+  Status st = read_surface(in, soup, &hexes_ignored);
   if (!st.ok()) return report_error(st);
+  warn_hexes_ignored(in, hexes_ignored);
   SurfaceDiagnosis d = diagnose_surface(soup, sharp_angle, make_context(nullptr, false));
   std::printf("%s", to_text(d).c_str());
   if (!json_out.empty()) {
@@ -121,9 +132,11 @@ int cmd_mesh(const std::string& in, const std::string& out, const std::string& r
   Context ctx = make_context(&progress, quiet);
   auto t = Clock::now();
   PolygonSoup soup;
-  Status st = read_surface(in, soup);
+  int64_t hexes_ignored = 0;
+  Status st = read_surface(in, soup, &hexes_ignored);
   const double read_s = seconds_since(t);
   if (!st.ok()) return report_error(st);
+  warn_hexes_ignored(in, hexes_ignored);
 
   MeshResult r = run_mesh(soup, params, ctx);
   progress.finish();

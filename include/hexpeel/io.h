@@ -22,8 +22,12 @@
 
 namespace hexpeel {
 
-/// Reads the polygons of a surface file. Indices are checked against the point count.
-Status read_surface(const std::filesystem::path& path, PolygonSoup& out);
+/// Reads the polygons of a surface file. Indices are checked against the point count. Volume
+/// cells (hexahedra, e.g. of a Gmsh or VTK volume mesh) are not part of the surface: their count
+/// is stored in `hexes_ignored` when given; a file with hexahedra and no faces is an error that
+/// says so.
+Status read_surface(const std::filesystem::path& path, PolygonSoup& out,
+                    int64_t* hexes_ignored = nullptr);
 
 /// Writes a quad surface (.obj or .off), atomically.
 Status write_surface(const std::filesystem::path& path, const QuadSurface& surface);

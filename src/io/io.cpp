@@ -97,8 +97,9 @@ bool is_surface_extension(const std::filesystem::path& path) {
   return surface_reader(lower_extension(path)) != nullptr;
 }
 
-Status read_surface(const std::filesystem::path& path, PolygonSoup& out) {
+Status read_surface(const std::filesystem::path& path, PolygonSoup& out, int64_t* hexes_ignored) {
   out = PolygonSoup{};
+  if (hexes_ignored != nullptr) *hexes_ignored = 0;
   const Reader reader = surface_reader(lower_extension(path));
   if (reader == nullptr) return unsupported(path, "surface", kSurfaceExtensions);
   CellSoup soup;
@@ -110,7 +111,9 @@ Status read_surface(const std::filesystem::path& path, PolygonSoup& out) {
   }
   const int64_t n = static_cast<int64_t>(soup.points.size());
   PolygonSoup result;
+  int64_t hexes = 0;
   for (size_t c = 0; c < soup.kinds.size(); ++c) {
+    if (soup.kinds[c] == CellKind::hex) ++hexes;
     if (soup.kinds[c] != CellKind::polygon) continue;
     if (Status s = check_corners(soup, n, c, name, "face", StatusCode::index_out_of_range); !s.ok()) {
       return s;
@@ -121,10 +124,17 @@ Status read_surface(const std::filesystem::path& path, PolygonSoup& out) {
     result.offsets.push_back(static_cast<int32_t>(result.indices.size()));
   }
   if (result.num_faces() == 0) {
+    if (hexes > 0) {
+      return Status::error(StatusCode::empty_mesh,
+                           name + ": the file holds " + std::to_string(hexes) +
+                               " hexahedra and no surface faces: give the quad surface to mesh "
+                               "(e.g. the boundary of this hex mesh as .obj)");
+    }
     return Status::error(StatusCode::empty_mesh, name + ": the file holds no surface faces");
   }
   result.points = std::move(soup.points);
   out = std::move(result);
+  if (hexes_ignored != nullptr) *hexes_ignored = hexes;
   return Status::success();
 }
 

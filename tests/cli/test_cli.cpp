@@ -359,6 +359,42 @@ TEST_F(Cli, CheckReportsUnreadableFiles) {
   EXPECT_TRUE(contains(folder.err, "directory")) << folder.err;
 }
 
+// A hex mesh given as the surface: without faces an error naming its hexahedra, writing
+// nothing; with its boundary quads beside them, a warning and the quads are meshed.
+TEST_F(Cli, HexMeshGivenAsSurface) {
+  const std::string in = write("cube2.obj", gen::cube(2, 2, 2, 0.5).surface);
+  ASSERT_EQ(run({"mesh", in, "-o", path("m.vtk"), "-q"}).exit_code, 0);
+  const Outcome volume = run({"mesh", path("m.vtk"), "-o", path("n.vtk"), "-q"});
+  EXPECT_NO_SIGNAL(volume);
+  EXPECT_NE(volume.exit_code, 0);
+  EXPECT_TRUE(contains(volume.err, "8 hexahedra and no surface faces")) << volume.err;
+  EXPECT_FALSE(fs::exists(path("n.vtk")));
+
+  HexMesh mesh;
+  ASSERT_TRUE(read_hex_mesh(path("m.vtk"), mesh).ok());
+  const QuadSurface cube = gen::cube(2, 2, 2, 0.5).surface;
+  std::string v = "# vtk DataFile Version 4.2\nx\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS " +
+                  std::to_string(mesh.points.size()) + " double\n";
+  for (const Vec3& p : mesh.points) v += std::to_string(p.x()) + " " + std::to_string(p.y()) + " " + std::to_string(p.z()) + "\n";
+  const size_t cells = mesh.hexes.size() + cube.quads.size();
+  v += "CELLS " + std::to_string(cells) + " " + std::to_string(9 * mesh.hexes.size() + 5 * cube.quads.size()) + "\n";
+  for (const Hex& h : mesh.hexes) {
+    v += "8";
+    for (int32_t c : h) v += " " + std::to_string(c);
+    v += "\n";
+  }
+  // hexpeel keeps the input's vertices first, in their order: the cube's quads index them as is
+  for (const Quad& q : cube.quads) v += "4 " + std::to_string(q[0]) + " " + std::to_string(q[1]) + " " + std::to_string(q[2]) + " " + std::to_string(q[3]) + "\n";
+  v += "CELL_TYPES " + std::to_string(cells) + "\n";
+  for (size_t c = 0; c < cells; ++c) v += c < mesh.hexes.size() ? "12\n" : "9\n";
+  spit(path("both.vtk"), v);
+  const Outcome both = run({"mesh", path("both.vtk"), "-o", path("b.vtk"), "-q"});
+  EXPECT_NO_SIGNAL(both);
+  EXPECT_EQ(both.exit_code, 0) << both.err;
+  EXPECT_TRUE(contains(both.err, "8 hexahedra ignored")) << both.err;
+  EXPECT_TRUE(fs::exists(path("b.vtk")));
+}
+
 TEST_F(Cli, CheckNeverCrashesOnDamagedBytes) {
   const std::string good = obj_text(test::grid_soup(2));
   uint32_t x = 12345;

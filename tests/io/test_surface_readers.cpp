@@ -111,6 +111,29 @@ TEST(SurfaceReaders, EmptyAndUnknownFiles) {
   EXPECT_EQ(read_surface(dir / "missing.obj", soup).code, StatusCode::io_error);
 }
 
+// A volume mesh given as the surface: its hexahedra are not the surface; with no faces beside
+// them the error says what the file holds.
+TEST(SurfaceReaders, HexahedraAreNotTheSurface) {
+  const test_io::ScratchDir scratch_dir("surface_hexes");
+  const auto& dir = scratch_dir.path();
+  const std::string head = "# vtk DataFile Version 4.2\nx\nASCII\nDATASET UNSTRUCTURED_GRID\n"
+                           "POINTS 8 double\n0 0 0 1 0 0 1 1 0 0 1 0 0 0 1 1 0 1 1 1 1 0 1 1\n";
+  test_io::write_bytes(dir / "hex.vtk", head + "CELLS 1 9\n8 0 1 2 3 4 5 6 7\nCELL_TYPES 1\n12\n");
+  PolygonSoup soup;
+  int64_t hexes = -1;
+  const Status s = read_surface(dir / "hex.vtk", soup, &hexes);
+  EXPECT_EQ(s.code, StatusCode::empty_mesh);
+  EXPECT_NE(s.message.find("1 hexahedra and no surface faces"), std::string::npos) << s.message;
+  EXPECT_EQ(hexes, 0);  // nothing read
+
+  test_io::write_bytes(dir / "both.vtk",
+                       head + "CELLS 7 39\n8 0 1 2 3 4 5 6 7\n4 0 3 2 1\n4 4 5 6 7\n4 0 1 5 4\n"
+                              "4 1 2 6 5\n4 2 3 7 6\n4 3 0 4 7\nCELL_TYPES 7\n12\n9\n9\n9\n9\n9\n9\n");
+  ASSERT_TRUE(read_surface(dir / "both.vtk", soup, &hexes).ok());
+  EXPECT_EQ(hexes, 1);
+  EXPECT_EQ(soup.num_faces(), 6);
+}
+
 TEST(SurfaceReaders, UnsupportedVariantsSaySo) {
   const test_io::ScratchDir scratch_dir("surface_variants");
   const auto& dir = scratch_dir.path();
