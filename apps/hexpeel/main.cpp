@@ -49,37 +49,46 @@ int report_error(const Status& s) {
   return exit_code(s);
 }
 
-/// Progress on stderr: one line, updated at most every 0.25 s, shown once a run has taken
-/// more than a second (short runs stay quiet).
+/// Progress on stderr, shown once a run has taken more than a second (short runs stay quiet).
+/// On a terminal: one line, redrawn at most every 0.25 s. Otherwise (a log file, a pipe): a line
+/// when the stage changes and at most every 5 s within a stage, so a long run's log stays short.
 struct Progress {
   bool enabled = true;
   bool tty = isatty(fileno(stderr)) != 0;
   Clock::time_point start = Clock::now(), last = start;
-  bool shown = false;
+  std::string last_stage;
+  bool shown = false;  ///< a terminal line is showing (a message must clear it first)
 
   void operator()(std::string_view stage, double fraction) {
     if (!enabled) return;
     auto now = Clock::now();
     if (std::chrono::duration<double>(now - start).count() < 1.0) return;
-    if (std::chrono::duration<double>(now - last).count() < 0.25 && fraction < 1.0) return;
+    const bool new_stage = stage != last_stage;
+    const double interval = tty ? 0.25 : 5.0;
+    if (!new_stage && std::chrono::duration<double>(now - last).count() < interval &&
+        !(tty && fraction >= 1.0))
+      return;
     last = now;
+    last_stage = stage;
     std::fprintf(stderr, "%s%-16.*s %5.1f%%  %6.1fs%s", tty ? "\r" : "",
                  static_cast<int>(stage.size()), stage.data(), 100.0 * fraction,
                  std::chrono::duration<double>(now - start).count(), tty ? "" : "\n");
     std::fflush(stderr);
-    shown = true;
+    shown = tty;
   }
+  /// Ends a terminal line that is showing, so that what is printed next starts on its own line.
   void finish() {
-    if (shown && tty) std::fprintf(stderr, "\n");
+    if (shown) std::fprintf(stderr, "\n");
     shown = false;
   }
 };
 
 Context make_context(Progress* progress, bool quiet) {
   Context ctx;
-  ctx.log = [quiet](LogLevel level, std::string_view msg) {
+  ctx.log = [quiet, progress](LogLevel level, std::string_view msg) {
     if (quiet && level != LogLevel::warning) return;
     if (level == LogLevel::debug) return;
+    if (progress) progress->finish();
     std::fprintf(stderr, "hexpeel: %s%.*s\n", level == LogLevel::warning ? "warning: " : "",
                  static_cast<int>(msg.size()), msg.data());
   };
