@@ -6,7 +6,7 @@
 //                [--improve-budget S] [--seed N] [--side-rule cost|heavier] [--side-threshold W]
 //                [--method original|kremer] [--no-zero-volume] [--no-enclosed] [--no-concave]
 //                [--no-false-positive] [--no-concave-waits] [--strict-intrusion]
-//                [--no-intrusion-cover]
+//                [--no-intrusion-cover] [--intrusion-flip-rounds N]
 //                [--pillow auto|all|none] [--no-untangle] [--no-optimize]
 //                [--polish-iterations N] [--quality-passes N] [--regularization W]
 //                [--final-polish-runs N] [--final-polish-softmin G] [--final-polish-rounds N]
@@ -382,6 +382,12 @@ int main(int argc, char** argv) {
                  "covering steps after its concave steps (default: rebuild it; when all its "
                  "intrusions go, mesh it too and keep the better mesh; screw2: 5 refused -> none, min / mean scaled "
                  "Jacobian 0.07 / 0.64 -> 0.28 / 0.80)");
+  mesh->add_option("--intrusion-flip-rounds", params.intrusion_flip_rounds,
+                   "when the plan meshed still has refused intrusions, replay it with those "
+                   "concave steps eliminated towards their other side as convex steps (again "
+                   "for what that plan refuses, up to N rounds), mesh it too when it refuses "
+                   "fewer, and keep the better mesh (0 = off)")
+      ->check(CLI::Range(0, 100))->capture_default_str();
   std::string pillow = "auto";
   bool no_untangle = false, no_optimize = false;
   mesh->add_option("--pillow", pillow,

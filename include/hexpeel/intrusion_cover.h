@@ -35,7 +35,17 @@ struct IntrusionCoverStats {
   int32_t refused_before = 0;     ///< intrusions refused with the first plan
   int32_t refused_after = 0;      ///< ... and with the rebuilt one (-1 when it did not plan)
   int64_t predicted_hexes = 0;    ///< of the rebuilt plan
+  double replan_effort_s = 0.0;   ///< planning work of the replans, in budget seconds
   double time_s = 0.0;            ///< rebuilding, planning and reconstruction of the rebuilt plan
+                                  ///< (and of the flipped plans, below)
+  // flip_refused_steps, when intrusions stayed refused in the plan meshed
+  bool flip_tried = false;        ///< intrusions stayed refused in the plan meshed: flips ran
+  bool flip_kept = false;         ///< ... and its mesh is the one kept
+  int32_t flip_rounds = 0;        ///< flipped plans kept in turn (each refused fewer than the
+                                  ///< last; each flips the steps the last one refused)
+  int32_t flipped_steps = 0;      ///< steps turned to their other side, all rounds
+  int32_t flip_refused_before = 0;  ///< intrusions refused by the plan that was flipped
+  int32_t flip_refused_after = 0;   ///< ... and by the last flipped plan
 };
 
 /// Rebuilds `plan` (status ok, made on a state like `state`, no terminal fill) on `state`, which
@@ -49,5 +59,17 @@ struct IntrusionCoverStats {
 EliminationPlan cover_concave_steps(EliminationState& state, const EliminationPlan& plan,
                                     const PlannerParams& params, const Context& ctx,
                                     IntrusionCoverStats& stats, int max_replans = 8);
+
+/// The other remedy for refused intrusions: replays `plan` (status ok) on the fresh `state`,
+/// eliminating each step listed in `refused` (indices into plan.steps, concave steps whose
+/// intrusion was refused) towards its *other* side as a convex step. Extruding the refused side
+/// instead (reconstruction's fallback) lays a layer outward into the concavity, where it must
+/// fold; the other side's layer wraps the rest of the surface and meets the concavity with its
+/// chord quads as walls, as Müller-Hannemann's method would build it (|other side| hexes more).
+/// The set of chords eliminated is the same, so every step stays feasible; a step whose other
+/// side is not usable is kept as it was. `flipped` counts the steps changed. On return `state`
+/// holds the new plan's final surface.
+EliminationPlan flip_refused_steps(EliminationState& state, const EliminationPlan& plan,
+                                   const std::vector<int32_t>& refused, int32_t& flipped);
 
 }  // namespace hexpeel

@@ -49,6 +49,11 @@ struct MeshParams {
   /// intrusions go, mesh it too and keep the better mesh (better_result). Only with the search
   /// planner.
   bool intrusion_cover = true;
+  /// When the plan meshed still has refused intrusions (no cover, or the cover refused some
+  /// too), replay it with those steps eliminated towards their other side as convex steps
+  /// (flip_refused_steps), again for the steps that plan refuses, up to this many rounds, and
+  /// mesh it too when it refuses fewer; the better mesh is kept (better_result). 0 = off.
+  int intrusion_flip_rounds = 3;
   PlacementParams placement;
   UntangleParams untangle;        ///< untangling and quality optimization, after placement
   QualityParams quality;
@@ -71,7 +76,8 @@ struct MeshTimings {
   double pillow_retry_s = 0;  ///< pillow, placement, untangling and quality of the embeddings
                               ///< not kept by the pillow retry and the repair pillow
   double intrusion_cover_s = 0;  ///< rebuilding the plan with covering steps, its
-                                 ///< reconstruction, and the embedding of the plan not kept
+                                 ///< reconstruction, and the embedding of the plan not kept;
+                                 ///< also the flipped plans (intrusion_flip_rounds)
 };
 /// The pillow retry (MeshParams::pillow_retry_band) or the repair pillow
 /// (MeshParams::repair_rounds) of the order kept.

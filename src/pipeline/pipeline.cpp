@@ -295,6 +295,102 @@ Context holding_warnings(const Context& ctx, std::vector<std::string>& held) {
   return c;
 }
 
+/// A plan of r's surface other than r's (rebuilt by the intrusion cover, or flipped), and its
+/// reconstruction `rec`, embedded (pillow retry included) as a result with r's method, planner,
+/// fill and elimination time.
+MeshResult embed_other_plan(const QuadSurface& surface, const MeshResult& r, EliminationPlan plan,
+                            const ReconstructionResult& rec, const MeshParams& params,
+                            const Context& ctx) {
+  MeshResult o;
+  o.method = r.method;
+  o.plan = std::move(plan);
+  o.planner = r.planner;
+  o.terminal = r.terminal;
+  o.reconstruction = rec.stats;
+  o.timings.elimination_s = r.timings.elimination_s;
+  o.timings.reconstruction_s = r.timings.reconstruction_s;
+  embed(surface, rec.complex, params, params.pillow, ctx, o, &o.complex);
+  if (o.status.ok()) retry_pillow(surface, rec.complex, params, ctx, o);
+  return o;
+}
+
+/// Keeps the better of r and `other` in r (better_result; a tie keeps r), with its warnings in
+/// `held` and r's intrusion cover stats, to which the embedding time of the one dropped goes.
+/// Returns whether `other` was kept.
+bool keep_better(MeshResult& r, MeshResult&& other, std::vector<std::string>& held,
+                 std::vector<std::string>&& other_held) {
+  IntrusionCoverStats& cs = r.intrusion_cover;
+  const bool keep = better_result(other, r);
+  const MeshResult& dropped = keep ? r : other;
+  cs.time_s += embedding_seconds(dropped.timings) + dropped.timings.pillow_retry_s;
+  if (keep) {
+    other.intrusion_cover = cs;
+    r = std::move(other);
+    held = std::move(other_held);
+  }
+  return keep;
+}
+
+/// A flipped plan is not embedded when it predicts more than this many times the hexes of the
+/// plan it flips (each flipped step extrudes its other side, often most of the surface: a
+/// 1042-quad cut of pierrot's mesh, 2188 -> 4278 hexes for 3 steps).
+constexpr double kMaxFlipGrowth = 3.0;
+
+/// MeshParams::intrusion_flip_rounds: r's plan (meshed, with refused intrusions) replayed with
+/// its refused steps eliminated towards their other side, again for what that plan refuses,
+/// while a round refuses fewer; the last such plan is embedded and kept when better
+/// (keep_better), with its warnings instead of `held`.
+void flip_refused(const SurfaceDiagnosis& diagnosis, const MeshParams& params, const Context& ctx,
+                  MeshResult& r, std::vector<std::string>& held) {
+  const QuadSurface& surface = diagnosis.validation.surface;
+  IntrusionCoverStats& cs = r.intrusion_cover;
+  const auto t0 = std::chrono::steady_clock::now();
+  cs.flip_tried = true;
+  cs.flip_refused_before = static_cast<int32_t>(r.reconstruction.invalid_intrusion_steps.size());
+  cs.flip_refused_after = cs.flip_refused_before;
+  std::vector<std::string> held_flip;
+  EliminationPlan plan;
+  ReconstructionResult rec;
+  const EliminationPlan* from = &r.plan;
+  const std::vector<int32_t>* refused = &r.reconstruction.invalid_intrusion_steps;
+  for (int round = 0; round < params.intrusion_flip_rounds && !refused->empty(); ++round) {
+    EliminationState state(surface, diagnosis.chords, diagnosis.edges);
+    int32_t flipped = 0;
+    EliminationPlan next = flip_refused_steps(state, *from, *refused, flipped);
+    if (!next.status.ok() || flipped == 0) break;
+    std::vector<std::string> warnings;
+    ReconstructionResult next_rec = run_reconstruction(
+        surface, next, params.reconstruction, holding_warnings(ctx, warnings), &state);
+    if (!next_rec.status.ok() || next_rec.stats.invalid_intrusion_steps.size() >= refused->size())
+      break;
+    ++cs.flip_rounds;
+    cs.flipped_steps += flipped;
+    plan = std::move(next);
+    rec = std::move(next_rec);
+    held_flip = std::move(warnings);
+    from = &plan;
+    refused = &rec.stats.invalid_intrusion_steps;
+    cs.flip_refused_after = static_cast<int32_t>(refused->size());
+  }
+  cs.time_s += seconds_since(t0);
+  if (cs.flip_rounds == 0) return;
+  if (static_cast<double>(plan.stats.predicted_hexes) >
+      kMaxFlipGrowth * static_cast<double>(r.plan.stats.predicted_hexes)) {
+    ctx.info("the plan with refused concave steps turned to their other side predicts " +
+             std::to_string(plan.stats.predicted_hexes) + " hexes, over 3 times the " +
+             std::to_string(r.plan.stats.predicted_hexes) + " planned: not built");
+    return;
+  }
+  ctx.info(std::to_string(cs.flip_refused_before) + " intrusions refused: meshing the plan with " +
+           std::to_string(cs.flipped_steps) + " of its concave steps turned to their other side");
+  MeshResult flipped = embed_other_plan(surface, r, std::move(plan), rec, params,
+                                        holding_warnings(ctx, held_flip));
+  cs.flip_kept = keep_better(r, std::move(flipped), held, std::move(held_flip));
+}
+
+/// Least planning budget of the intrusion cover's replans (budget seconds).
+constexpr double kMinCoverBudget = 3.0;
+
 /// The stages after the input checks, with elimination order `order`; fills everything but
 /// `diagnosis`, `tries` and the check time. `plans` holds the keys of the plans meshed before;
 /// when this order plans one of them again, it stops after planning and `same_as` names it.
@@ -357,8 +453,10 @@ MeshResult mesh_with_order(const SurfaceDiagnosis& diagnosis, const MeshParams& 
   // With the cover to try, warnings wait until it is known which plan is meshed.
   const bool may_cover = params.intrusion_cover && params.search && r.plan.stats.concave_steps > 0 &&
                          r.plan.terminal.empty();
+  // ... and so may the flip of refused steps (flip_refused).
+  const bool may_flip = params.intrusion_flip_rounds > 0 && r.plan.stats.concave_steps > 0;
   std::vector<std::string> held;
-  const Context quiet = may_cover ? holding_warnings(ctx, held) : ctx;
+  const Context quiet = may_cover || may_flip ? holding_warnings(ctx, held) : ctx;
   ReconstructionResult rec = run_reconstruction(surface, r.plan, params.reconstruction, quiet, &state);
   r.reconstruction = rec.stats;
   r.timings.reconstruction_s = seconds_since(t);
@@ -376,6 +474,11 @@ MeshResult mesh_with_order(const SurfaceDiagnosis& diagnosis, const MeshParams& 
     cs.refused_after = -1;
     PlannerParams pp = params.planner;
     pp.order = order;
+    // The replans are a second try at a plan already found: they get what the first search
+    // used, twice over and at least kMinCoverBudget, not the whole budget again (a 1042-quad
+    // cut of pierrot's mesh planned in 2 budget seconds, then its replans searched the whole
+    // 30 without a plan, 43 s, in each of the four orders; screw2's replan takes 0.4).
+    pp.budget_s = std::min(pp.budget_s, std::max(kMinCoverBudget, 2.0 * r.planner.effort_s));
     EliminationState cover_state(surface, diagnosis.chords, diagnosis.edges);
     EliminationPlan cp = cover_concave_steps(cover_state, r.plan, pp, quiet, cs);
     if (cp.status.ok()) {
@@ -387,13 +490,7 @@ MeshResult mesh_with_order(const SurfaceDiagnosis& diagnosis, const MeshParams& 
         cs.refused_after = static_cast<int32_t>(rec2.stats.invalid_intrusion_steps.size());
       if (rec2.status.ok() && cs.refused_after == 0) {
         cover = true;
-        covered.method = r.method;
-        covered.plan = std::move(cp);
-        covered.planner = r.planner;
-        covered.reconstruction = rec2.stats;
-        covered.timings = r.timings;
-        embed(surface, rec2.complex, params, params.pillow, quiet_cover, covered, &covered.complex);
-        if (covered.status.ok()) retry_pillow(surface, rec2.complex, params, quiet_cover, covered);
+        covered = embed_other_plan(surface, r, std::move(cp), rec2, params, quiet_cover);
       }
     }
   }
@@ -403,18 +500,11 @@ MeshResult mesh_with_order(const SurfaceDiagnosis& diagnosis, const MeshParams& 
   } else {
     r.status = rec.status;
   }
-  if (cover) {
-    IntrusionCoverStats& cs = r.intrusion_cover;
-    const bool keep = better_result(covered, r);
-    MeshResult& dropped = keep ? r : covered;
-    cs.time_s += embedding_seconds(dropped.timings) + dropped.timings.pillow_retry_s;
-    cs.kept = keep;
-    covered.intrusion_cover = cs;
-    if (keep) {
-      r = std::move(covered);
-      held = std::move(held_cover);
-    }
-  }
+  if (cover)
+    r.intrusion_cover.kept = keep_better(r, std::move(covered), held, std::move(held_cover));
+  if (params.intrusion_flip_rounds > 0 && r.status.ok() &&
+      !r.reconstruction.invalid_intrusion_steps.empty())
+    flip_refused(diagnosis, params, ctx, r, held);
   r.timings.intrusion_cover_s = r.intrusion_cover.time_s;
   for (const std::string& w : held) ctx.warn(w);
   return r;
@@ -672,9 +762,10 @@ nlohmann::json to_json(const MeshResult& r) {
                     {"time_s", r.planner.time_s},
                     {"first_plan_s", r.planner.first_plan_s}};
   }
-  if (r.intrusion_cover.tried) {
+  if (r.intrusion_cover.tried || r.intrusion_cover.flip_tried) {
     const IntrusionCoverStats& c = r.intrusion_cover;
-    j["intrusion_cover"] = {{"kept", c.kept},
+    j["intrusion_cover"] = {{"tried", c.tried},
+                            {"kept", c.kept},
                             {"cover_steps", c.cover_steps},
                             {"replans", c.replans},
                             {"uncovered_quads", c.uncovered_quads},
@@ -682,7 +773,14 @@ nlohmann::json to_json(const MeshResult& r) {
                             {"refused_after", c.refused_after < 0 ? nlohmann::json(nullptr)
                                                                   : nlohmann::json(c.refused_after)},
                             {"predicted_hexes", c.predicted_hexes},
-                            {"time_s", c.time_s}};
+                            {"replan_effort_s", c.replan_effort_s},
+                            {"time_s", c.time_s},
+                            {"flip", {{"tried", c.flip_tried},
+                                      {"kept", c.flip_kept},
+                                      {"rounds", c.flip_rounds},
+                                      {"flipped_steps", c.flipped_steps},
+                                      {"refused_before", c.flip_refused_before},
+                                      {"refused_after", c.flip_refused_after}}}};
   }
   j["reconstruction"] = {{"hexes", r.reconstruction.hexes},
                          {"slit_edges", r.reconstruction.slit_edges},

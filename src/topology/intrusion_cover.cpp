@@ -60,6 +60,44 @@ std::vector<PlanStep> add_covers(EliminationState& state, std::vector<int32_t>& 
   return out;
 }
 
+/// Replays plan step b on `state` and appends it to out's steps with b's flags, towards b's other
+/// side as a convex step when `flip` and that side is usable. False, with an internal error in
+/// out.status, when b cannot be replayed (its chord gone or infeasible, its side unusable).
+bool replay_step(EliminationState& state, const PlanStep& b, bool flip, EliminationPlan& out) {
+  const auto f = state.chord_alive(b.chord) ? state.feasibility(b.chord)
+                                             : EliminationState::Feasibility{};
+  if (!state.chord_alive(b.chord) || !f.ok() || !f.sides[b.side]) {
+    out.status = Status::error(StatusCode::internal_error,
+                               "a step of the plan cannot be replayed (chord " +
+                                   std::to_string(b.chord) + ")");
+    return false;
+  }
+  const bool other = flip && f.sides[1 - b.side];
+  PlanStep ps = state.apply(b.chord, other ? 1 - b.side : b.side);
+  ps.concave = b.concave && !other;
+  ps.flat = b.flat;
+  ps.priority = b.priority;
+  out.steps.push_back(std::move(ps));
+  return true;
+}
+
+/// out's final surface (the one `state` holds after its steps) and its stats' step counts.
+/// A plan that ends on a filled stuck surface starts from that fill's hexes, not one cube.
+void close_plan(const EliminationState& state, EliminationPlan& out) {
+  state.current_surface(&out.final_quads);
+  out.final_corners.clear();
+  for (int32_t q : out.final_quads) out.final_corners.push_back(state.corners(q));
+  out.stats.steps = static_cast<int32_t>(out.steps.size());
+  out.stats.predicted_hexes =
+      out.terminal.empty() ? 1 : static_cast<int64_t>(out.terminal.hexes.size());
+  out.stats.concave_steps = out.stats.flat_steps = 0;
+  for (const PlanStep& s : out.steps) {
+    out.stats.predicted_hexes += (s.concave ? -1 : 1) * static_cast<int64_t>(s.side_quads.size());
+    out.stats.concave_steps += s.concave;
+    out.stats.flat_steps += s.flat;
+  }
+}
+
 /// cover_concave_steps without the timing.
 EliminationPlan rebuild(EliminationState& state, const EliminationPlan& plan,
                         const PlannerParams& params, const Context& ctx,
@@ -77,22 +115,11 @@ EliminationPlan rebuild(EliminationState& state, const EliminationPlan& plan,
     for (; pos < todo.size(); ++pos) {
       const PlanStep& b = todo[pos];
       if (in_run && !b.concave) break;
-      const auto f = state.chord_alive(b.chord) ? state.feasibility(b.chord)
-                                                 : EliminationState::Feasibility{};
-      if (!state.chord_alive(b.chord) || !f.ok() || !f.sides[b.side]) {
-        out.status = Status::error(StatusCode::internal_error,
-                                   "intrusion cover: a step of the plan cannot be replayed");
-        return out;
-      }
-      PlanStep ps = state.apply(b.chord, b.side);
-      ps.concave = b.concave;
-      ps.flat = b.flat;
-      ps.priority = b.priority;
-      if (ps.concave) {
+      if (!replay_step(state, b, false, out)) return out;
+      if (out.steps.back().concave) {
         in_run = true;
-        for (int32_t q : ps.side_quads) ++pending[q];
+        for (int32_t q : out.steps.back().side_quads) ++pending[q];
       }
-      out.steps.push_back(std::move(ps));
     }
     if (!in_run) break;  // replayed to the end
     std::vector<PlanStep> covers;
@@ -118,6 +145,7 @@ EliminationPlan rebuild(EliminationState& state, const EliminationPlan& plan,
     }
     PlannerResult rest = run_planner(state, rp, ctx);
     replan_effort += rest.stats.effort_s;
+    stats.replan_effort_s = replan_effort;
     if (!rest.plan.status.ok()) {
       out.status = rest.plan.status;
       return out;
@@ -127,22 +155,11 @@ EliminationPlan rebuild(EliminationState& state, const EliminationPlan& plan,
     todo = std::move(rest.plan.steps);
     pos = 0;
   }
-  std::vector<int32_t> ids;
-  state.current_surface(&ids);
-  if (ids.size() != 6) {
+  out.stats = plan.stats;
+  close_plan(state, out);
+  if (out.final_quads.size() != 6) {
     out.status = Status::error(StatusCode::internal_error, "intrusion cover: the plan did not end on a cube");
     return out;
-  }
-  out.final_quads = ids;
-  for (int32_t q : ids) out.final_corners.push_back(state.corners(q));
-  out.stats = plan.stats;
-  out.stats.steps = static_cast<int32_t>(out.steps.size());
-  out.stats.predicted_hexes = 1;
-  out.stats.concave_steps = out.stats.flat_steps = 0;
-  for (const PlanStep& s : out.steps) {
-    out.stats.predicted_hexes += (s.concave ? -1 : 1) * static_cast<int64_t>(s.side_quads.size());
-    out.stats.concave_steps += s.concave;
-    out.stats.flat_steps += s.flat;
   }
   stats.predicted_hexes = out.stats.predicted_hexes;
   return out;
@@ -157,6 +174,25 @@ EliminationPlan cover_concave_steps(EliminationState& state, const EliminationPl
   stats.tried = true;
   EliminationPlan out = rebuild(state, plan, params, ctx, stats, max_replans);
   stats.time_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return out;
+}
+
+EliminationPlan flip_refused_steps(EliminationState& state, const EliminationPlan& plan,
+                                   const std::vector<int32_t>& refused, int32_t& flipped) {
+  flipped = 0;
+  EliminationPlan out;
+  out.terminal = plan.terminal;
+  out.stats = plan.stats;
+  const int32_t n = static_cast<int32_t>(plan.steps.size());
+  std::vector<uint8_t> flip(n, 0);
+  for (int32_t i : refused)
+    if (i >= 0 && i < n && plan.steps[i].concave) flip[i] = 1;
+  for (int32_t i = 0; i < n; ++i) {
+    if (!replay_step(state, plan.steps[i], flip[i] != 0, out)) return out;
+    flipped += out.steps.back().side != plan.steps[i].side;
+  }
+  close_plan(state, out);
+  out.status = Status::success();
   return out;
 }
 

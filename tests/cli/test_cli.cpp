@@ -571,7 +571,8 @@ TEST_F(Cli, PillowRetryBandOption) {
 TEST_F(Cli, IntrusionCoverOption) {
   const std::string in = write("rvox.obj", gen::random_voxel_solid(374, 6, 28, 1).surface);
   auto report = [&](const std::vector<std::string>& extra) { return mesh_report(in, extra); };
-  const nlohmann::json on = report({}), off = report({"--no-intrusion-cover"});
+  const nlohmann::json on = report({}),
+                       off = report({"--no-intrusion-cover", "--intrusion-flip-rounds", "0"});
   ASSERT_TRUE(on.contains("intrusion_cover")) << on.dump();
   const nlohmann::json& c = on.at("intrusion_cover");
   EXPECT_GT(c.at("refused_before").get<int>(), 0);
@@ -585,6 +586,18 @@ TEST_F(Cli, IntrusionCoverOption) {
   EXPECT_EQ(on.at("scaled_jacobian").at("min").get<double>(), 1.0);
   EXPECT_EQ(on.at("reconstruction").at("invalid_intrusion_steps"),
             off.at("reconstruction").at("invalid_intrusion_steps"));
+  // The flip (--intrusion-flip-rounds) turns the refused step to its other side: every
+  // intrusion goes, but the refused step extruded gave the ideal cubes, which stay.
+  const nlohmann::json& f = on.at("intrusion_cover").at("flip");
+  EXPECT_TRUE(f.at("tried").get<bool>());
+  EXPECT_FALSE(f.at("kept").get<bool>());
+  EXPECT_EQ(f.at("refused_before").get<int>(), c.at("refused_before").get<int>());
+  EXPECT_EQ(f.at("refused_after").get<int>(), 0);
+  EXPECT_GE(f.at("flipped_steps").get<int>(), 1);
+  const nlohmann::json flip_only = report({"--no-intrusion-cover"});
+  EXPECT_FALSE(flip_only.at("intrusion_cover").at("tried").get<bool>());
+  EXPECT_TRUE(flip_only.at("intrusion_cover").at("flip").at("tried").get<bool>());
+  EXPECT_EQ(flip_only.at("hexes").get<int>(), off.at("hexes").get<int>());
   // --strict-intrusion stops the first reconstruction at its first refusal; the rebuilt plan,
   // which intrudes every concave step, is then the only mesh, and it is kept.
   const nlohmann::json strict = report({"--strict-intrusion"});

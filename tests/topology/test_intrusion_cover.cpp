@@ -129,3 +129,42 @@ TEST(IntrusionCover, APlanWithoutConcaveStepsComesBackAsItWas) {
   EXPECT_EQ(stats.cover_steps, 0);
   EXPECT_EQ(stats.replans, 0);
 }
+
+TEST(IntrusionFlip, TurnsTheRefusedStepsToTheirOtherSide) {
+  for (int m : {1, 2}) {
+    SCOPED_TRACE("m = " + std::to_string(m));
+    ht::Prepared p = ht::prepare(well(3, m).surface);
+    EliminationState bad_state(p.surface, p.chords, p.edges);
+    EliminationPlan bad = crossing_plan(bad_state);
+    ASSERT_TRUE(bad.status.ok()) << "no concave run followed by a crossing chord";
+    ReconstructionResult spoilt = run_reconstruction(p.surface, bad, {}, {}, &bad_state);
+    ASSERT_TRUE(spoilt.status.ok()) << spoilt.status.message;
+    const std::vector<int32_t>& refused = spoilt.stats.invalid_intrusion_steps;
+    ASSERT_FALSE(refused.empty());
+
+    EliminationState state(p.surface, p.chords, p.edges);
+    int32_t flipped = 0;
+    EliminationPlan flip = flip_refused_steps(state, bad, refused, flipped);
+    ASSERT_TRUE(flip.status.ok()) << flip.status.message;
+    EXPECT_EQ(flipped, static_cast<int32_t>(refused.size()));
+    ASSERT_EQ(flip.steps.size(), bad.steps.size());
+    int64_t hexes = 1;
+    for (size_t i = 0; i < bad.steps.size(); ++i) {
+      const bool was_refused = std::find(refused.begin(), refused.end(), static_cast<int32_t>(i)) != refused.end();
+      EXPECT_EQ(flip.steps[i].chord, bad.steps[i].chord);
+      EXPECT_EQ(flip.steps[i].side, was_refused ? 1 - bad.steps[i].side : bad.steps[i].side);
+      EXPECT_EQ(flip.steps[i].concave, bad.steps[i].concave && !was_refused);
+      if (!was_refused) EXPECT_EQ(flip.steps[i].side_quads, bad.steps[i].side_quads);
+      hexes += (flip.steps[i].concave ? -1 : 1) * static_cast<int64_t>(flip.steps[i].side_quads.size());
+    }
+    EXPECT_EQ(flip.stats.predicted_hexes, hexes);
+    EXPECT_EQ(flip.stats.concave_steps, concave_steps(bad) - flipped);
+    EXPECT_EQ(flip.final_quads, bad.final_quads);  // the same chords went: the same cube
+
+    ReconstructionResult rec = run_reconstruction(p.surface, flip, {}, {}, &state);
+    ASSERT_TRUE(rec.status.ok()) << rec.status.message;
+    EXPECT_LT(rec.stats.invalid_intrusion_steps.size(), refused.size());
+    if (rec.stats.invalid_intrusion_steps.empty())
+      EXPECT_EQ(static_cast<int64_t>(rec.complex.hexes.size()), flip.stats.predicted_hexes);
+  }
+}

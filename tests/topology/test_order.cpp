@@ -50,6 +50,7 @@ MeshParams greedy_params(const OrderParams& order) {
   mp.pillow.mode = PillowMode::none;
   mp.untangle.untangle = mp.untangle.optimize = false;
   mp.alternatives = 0;  // these tests are about the given order
+  mp.intrusion_flip_rounds = 0;  // ... and its plan
   return mp;
 }
 
