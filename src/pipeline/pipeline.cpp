@@ -377,7 +377,8 @@ void flip_refused(const SurfaceDiagnosis& diagnosis, const MeshParams& params, c
   if (static_cast<double>(plan.stats.predicted_hexes) >
       kMaxFlipGrowth * static_cast<double>(r.plan.stats.predicted_hexes)) {
     ctx.info("the plan with refused concave steps turned to their other side predicts " +
-             std::to_string(plan.stats.predicted_hexes) + " hexes, over 3 times the " +
+             std::to_string(plan.stats.predicted_hexes) + " hexes, over " +
+             std::to_string(static_cast<int>(kMaxFlipGrowth)) + " times the " +
              std::to_string(r.plan.stats.predicted_hexes) + " planned: not built");
     return;
   }
