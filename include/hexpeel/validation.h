@@ -18,6 +18,10 @@ struct ValidationParams {
   double degenerate_area = 1e-14;
   /// Flip an inward-oriented surface (and warn) instead of rejecting it.
   bool flip_inward = true;
+  /// Reverse the quads whose orientation disagrees with their neighbours' (as CAD exports write
+  /// one face at a time) and warn, instead of rejecting the surface. A non-orientable surface is
+  /// always rejected.
+  bool reorient = true;
 };
 
 /// One problem found. Several may be found; the first error decides the status.
@@ -34,6 +38,8 @@ struct ValidationStats {
   int32_t components = 0;
   int32_t genus = -1;            ///< -1 when not computed (surface not closed/manifold)
   bool flipped = false;          ///< input was inward and has been flipped
+  /// quads reversed to agree with their neighbours before the inward check (input ids, sorted)
+  std::vector<int32_t> reoriented;
 };
 
 struct ValidationResult {

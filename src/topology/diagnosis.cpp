@@ -97,6 +97,9 @@ std::string to_text(const SurfaceDiagnosis& d) {
          " edges, " + std::to_string(st.components) +
          (st.components == 1 ? " part" : " parts") + ", genus " +
          (st.genus >= 0 ? std::to_string(st.genus) : std::string("not computed")) +
+         (st.reoriented.empty() ? ""
+                                : ", " + std::to_string(st.reoriented.size()) +
+                                      " quads reversed to agree with their neighbours") +
          (st.flipped ? ", flipped to face outward" : "") + "\n";
   }
   for (const auto& is : v.issues)
@@ -146,6 +149,7 @@ nlohmann::json to_json(const SurfaceDiagnosis& d) {
                      {"unused_vertices", st.unused_vertices},
                      {"components", st.components},
                      {"genus", st.genus},
+                     {"reoriented", st.reoriented},
                      {"flipped", st.flipped}};
   json self = json::array();
   for (size_t c = 0; c < d.chords.chords.size(); ++c) {

@@ -9,7 +9,8 @@
 //      show up again as an open boundary).
 //   2. topology, on the quads with unused vertices dropped: non-manifold edges, open boundary
 //      edges, non-manifold vertices (several fans of quads around one vertex), inconsistent
-//      orientation, several edge-connected components; then, on a closed manifold oriented
+//      orientation (the smaller class of an orientable surface is reversed and warned, or
+//      rejected), several edge-connected components; then, on a closed manifold oriented
 //      surface, the genus of each component (Euler characteristic) and the parity of the quad
 //      count (the boundary of a hex mesh has 6H - 2I quads, an even number).
 //   3. orientation: a surface that encloses a negative volume is flipped (warned) or rejected.
@@ -501,6 +502,23 @@ void Validator::check_topology() {
       }
       auto& few = members[0].size() <= members[1].size() ? members[0] : members[1];
       minority.insert(minority.end(), few.begin(), few.end());
+    }
+    // Only a surface that is otherwise a closed manifold is re-oriented; then it is checked
+    // again from the start, as if it had been given that way.
+    if (orientable && params.reorient && result.issues.empty()) {
+      std::sort(minority.begin(), minority.end());
+      Listing rev;
+      for (int32_t q : minority) {
+        std::swap(result.surface.quads[q][1], result.surface.quads[q][3]);
+        rev.add(std::to_string(q));
+      }
+      result.stats.reoriented = minority;
+      warn("the quads' orientations disagree across " +
+           plural(orient_items.total, "edge", "edges") + "; " +
+           plural(rev.total, "quad was", "quads were") + " reversed to agree with the rest: " +
+           rev.text());
+      check_topology();
+      return;
     }
     std::string hint;
     if (!orientable) {

@@ -270,8 +270,8 @@ std::vector<Bad> bad_inputs() {
     const PolygonSoup s = join(cube, other, {{vertex_at(other, 1, 1, 1), vertex_at(cube, 1, 1, 1)}});
     v.push_back({"nm_vertex.obj", obj_text(s), {"non_manifold_vertex", "vertex"}});
   }
-  v.push_back({"inconsistent.obj", obj_text(test::with_face_reversed(cube, 2)),
-               {"inconsistent_orientation", "quad"}});
+  v.push_back({"klein.obj", obj_text(test::klein_soup(6, 4)),
+               {"inconsistent_orientation", "not orientable"}});
   v.push_back({"two.obj", obj_text(join(cube, translated(cube, Vec3(3, 0, 0)))),
                {"multiple_components", "component"}});
   v.push_back({"torus.obj", obj_text(test::torus_soup(8, 4)), {"nonzero_genus", "genus 1"}});
@@ -344,6 +344,38 @@ TEST_F(Cli, CheckFlipsInwardSurfaceWithWarning) {
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(contains(r.err, "warning")) << r.err;
   EXPECT_TRUE(contains(r.err, "inward")) << r.err;
+}
+
+TEST_F(Cli, MixedOrientationIsReorientedAndMeshesTheSame) {
+  // One patch of quads (a CAD face, say) written the other way round, each from the same first
+  // corner: reversed back with a warning that counts them, and then the very mesh of the
+  // consistent surface.
+  const QuadSurface s = gen::cubed_sphere_equiangular(3).surface;
+  PolygonSoup mixed = to_polygon_soup(s);
+  int32_t reversed = 0;
+  for (int32_t q = 0; q < s.num_quads(); ++q) {
+    Vec3 c = Vec3::Zero();
+    for (int32_t v : s.quads[q]) c += s.points[v];
+    if (c.x() > 2.0) {
+      std::swap(mixed.indices[mixed.offsets[q] + 1], mixed.indices[mixed.offsets[q] + 3]);
+      ++reversed;
+    }
+  }
+  ASSERT_GT(reversed, 0);
+  ASSERT_LT(2 * reversed, s.num_quads());
+  const std::string good = write("good.obj", s), bad = write("mixed.obj", obj_text(mixed));
+  Outcome c = run({"check", bad});
+  EXPECT_EQ(c.exit_code, 0) << c.err;
+  EXPECT_TRUE(contains(c.err, std::to_string(reversed) + " quads were reversed")) << c.err;
+  Outcome a = run({"mesh", good, "-o", path("good.vtk"), "--quiet"});
+  Outcome b = run({"mesh", bad, "-o", path("mixed.vtk"), "--quiet", "--report", path("r.json")});
+  ASSERT_EQ(a.exit_code, 0) << a.err;
+  ASSERT_EQ(b.exit_code, 0) << b.err;
+  EXPECT_TRUE(contains(b.err, "reversed to agree")) << b.err;
+  EXPECT_TRUE(slurp(path("good.vtk")) == slurp(path("mixed.vtk")));
+  const auto report = nlohmann::json::parse(slurp(path("r.json")));
+  EXPECT_EQ(report["input"]["validation"]["reoriented"].size(), static_cast<size_t>(reversed))
+      << report.dump().substr(0, 400);
 }
 
 TEST_F(Cli, CheckReportsUnreadableFiles) {

@@ -75,6 +75,22 @@ inline PolygonSoup torus_soup(int n, int m) {
   return soup;
 }
 
+/// Quad Klein bottle: the n x m torus grid with its last column glued to the first reflected
+/// (j -> m - j), so no orientation of its quads is consistent. Points on a torus (the glued
+/// quads are long and skew, but not degenerate).
+inline PolygonSoup klein_soup(int n, int m) {
+  PolygonSoup soup = torus_soup(n, m);
+  soup.indices.clear();
+  soup.offsets.assign(1, 0);
+  auto id = [&](int i, int j) {
+    if (i == n) return static_cast<int32_t>((m - j % m) % m);
+    return static_cast<int32_t>(i * m + (j % m));
+  };
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < m; ++j) soup.add_face({id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)});
+  return soup;
+}
+
 /// Radial quad mesh of a polyhedron (faces counter-clockwise seen from outside): its vertices,
 /// then one vertex per face (the face centroid pushed out by `lift` along the face normal), and
 /// one quad (u, centre of the face right of u->w, w, centre of the face left of u->w) per edge.

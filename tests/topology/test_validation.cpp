@@ -26,6 +26,21 @@ const ValidationIssue* find_issue(const ValidationResult& r, StatusCode code) {
   return nullptr;
 }
 
+/// Whether every quad of s is the soup's face of the same id, up to its first corner.
+bool same_cycles(const QuadSurface& s, const PolygonSoup& soup) {
+  if (s.num_quads() != soup.num_faces()) return false;
+  for (int32_t f = 0; f < soup.num_faces(); ++f) {
+    bool found = false;
+    for (int r = 0; r < 4 && !found; ++r) {
+      found = true;
+      for (int i = 0; i < 4; ++i)
+        found = found && s.quads[f][(i + r) & 3] == soup.indices[soup.offsets[f] + i];
+    }
+    if (!found) return false;
+  }
+  return true;
+}
+
 TEST(Validation, CubeIsValid) {
   const ValidationResult r = run_validation(cube_soup());
   ASSERT_TRUE(r.status.ok()) << to_string(r.status);
@@ -140,16 +155,49 @@ TEST(Validation, TwoCubesSharingAVertex) {
   EXPECT_EQ(r.stats.genus, -1);
 }
 
-TEST(Validation, CubeWithOneFaceReversed) {
-  const ValidationResult r = run_validation(test::with_face_reversed(cube_soup(), 3));
+TEST(Validation, CubeWithOneFaceReversedIsReoriented) {
+  const PolygonSoup given = test::with_face_reversed(cube_soup(), 3);
+  const ValidationResult r = run_validation(given);
+  ASSERT_TRUE(r.status.ok()) << to_string(r.status);
+  EXPECT_EQ(r.stats.reoriented, std::vector<int32_t>{3});
+  EXPECT_FALSE(r.stats.flipped);
+  ASSERT_EQ(r.warnings.size(), 1u);
+  EXPECT_TRUE(contains(r.warnings[0], "disagree across 4 edges; 1 quad was reversed to agree with "
+                                      "the rest: 3"))
+      << r.warnings[0];
+  // The surface is the cube as it was before its face was reversed.
+  EXPECT_TRUE(same_cycles(r.surface, cube_soup()));
+
+  ValidationParams strict;
+  strict.reorient = false;
+  const ValidationResult e = run_validation(given, strict);
+  EXPECT_EQ(e.status.code, StatusCode::inconsistent_orientation);
+  EXPECT_TRUE(contains(e.status.message, "4 edges are traversed in the same direction"))
+      << e.status.message;
+  EXPECT_TRUE(contains(e.status.message, "reversing quad 3 would make it consistent"))
+      << e.status.message;
+  EXPECT_NE(std::find(e.issues[0].faces.begin(), e.issues[0].faces.end(), 3),
+            e.issues[0].faces.end());
+}
+
+TEST(Validation, MajorityReversedThenInwardIsFlippedWhole) {
+  // Four of the six faces reversed: the two others are the minority, reversed to agree; the
+  // result faces inward and is then flipped as a whole.
+  PolygonSoup s = cube_soup();
+  for (int32_t f : {0, 1, 2, 4}) s = test::with_face_reversed(s, f);
+  const ValidationResult r = run_validation(s);
+  ASSERT_TRUE(r.status.ok()) << to_string(r.status);
+  EXPECT_EQ(r.stats.reoriented, (std::vector<int32_t>{3, 5}));
+  EXPECT_TRUE(r.stats.flipped);
+  EXPECT_GT(signed_volume(r.surface), 0.0);
+  EXPECT_TRUE(same_cycles(r.surface, cube_soup()));
+}
+
+TEST(Validation, NonOrientableSurfaceIsRejected) {
+  const ValidationResult r = run_validation(test::klein_soup(6, 4));
   EXPECT_EQ(r.status.code, StatusCode::inconsistent_orientation);
-  EXPECT_TRUE(contains(r.status.message, "4 edges are traversed in the same direction"))
-      << r.status.message;
-  EXPECT_TRUE(contains(r.status.message, "reversing quad 3 would make it consistent"))
-      << r.status.message;
-  EXPECT_TRUE(contains(r.status.message, "quads ")) << r.status.message;
-  EXPECT_NE(std::find(r.issues[0].faces.begin(), r.issues[0].faces.end(), 3),
-            r.issues[0].faces.end());
+  EXPECT_TRUE(contains(r.status.message, "the surface is not orientable")) << r.status.message;
+  EXPECT_TRUE(r.stats.reoriented.empty());
 }
 
 TEST(Validation, TwoDisjointCubes) {
