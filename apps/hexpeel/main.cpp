@@ -113,6 +113,7 @@ int cmd_check(const std::string& in, double sharp_angle, const std::string& json
   warn_hexes_ignored(in, hexes_ignored);
   SurfaceDiagnosis d = diagnose_surface(soup, sharp_angle, make_context(nullptr, false));
   std::printf("%s", to_text(d).c_str());
+  std::printf("path: %s\n", mesh_path(d).c_str());
   if (!json_out.empty()) {
     Status w = write_text_file(json_out, to_json(d).dump(2) + "\n");
     if (!w.ok()) return report_error(w);

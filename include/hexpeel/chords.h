@@ -37,6 +37,7 @@ struct ChordStats {
   int32_t min_length = 0, max_length = 0;
   double mean_length = 0.0;
   int32_t self_intersecting = 0;
+  int32_t self_crossings = 0;  ///< quads passed twice by one chord, over all chords
 };
 ChordStats chord_stats(const ChordSet& chords);
 

@@ -27,6 +27,10 @@ struct SurfaceDiagnosis {
   Status status;
 };
 
+/// The way `mesh` would take with this surface, in one line: dual cycle elimination, or why
+/// none applies (for `hexpeel check`).
+std::string mesh_path(const SurfaceDiagnosis& diagnosis);
+
 /// Validates `soup`, finds its chords and classifies its edges (sharp above `sharp_angle_deg`,
 /// degrees of deviation from flat, range (0, 180)).
 SurfaceDiagnosis diagnose_surface(const PolygonSoup& soup, double sharp_angle_deg = 60.0,

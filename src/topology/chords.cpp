@@ -67,6 +67,7 @@ ChordStats chord_stats(const ChordSet& chords) {
     st.max_length = std::max(st.max_length, len);
     total += len;
     if (c.self_intersecting) ++st.self_intersecting;
+    st.self_crossings += static_cast<int32_t>(c.crossings.size());
   }
   st.mean_length = static_cast<double>(total) / st.count;
   return st;

@@ -85,6 +85,19 @@ SurfaceDiagnosis diagnose_surface(const PolygonSoup& soup, double sharp_angle_de
   return d;
 }
 
+std::string mesh_path(const SurfaceDiagnosis& d) {
+  if (d.status.ok()) return "dual cycle elimination (every chord is simple)";
+  if (d.status.code != StatusCode::self_intersecting_chord)
+    return "none (the surface is not valid input: " + std::string(to_string(d.status.code)) + ")";
+  const ChordStats& cs = d.chord_stats;
+  const bool odd = d.validation.surface.num_quads() % 2 != 0;
+  return "none: " + std::to_string(cs.self_intersecting) + " of " + std::to_string(cs.count) +
+         " chords cross themselves, at " + std::to_string(cs.self_crossings) + " quads" +
+         (odd ? " (an odd quad count forces one)" : "") +
+         "; hexpeel does not yet mesh such a surface with its quads kept (the shelling path is "
+         "not implemented): remesh it so that every chord is simple";
+}
+
 std::string to_text(const SurfaceDiagnosis& d) {
   const ValidationResult& v = d.validation;
   const ValidationStats& st = v.stats;
@@ -109,7 +122,8 @@ std::string to_text(const SurfaceDiagnosis& d) {
   if (cs.count > 0) {
     t += "chords: " + std::to_string(cs.count) + ", length min " + std::to_string(cs.min_length) +
          " / mean " + fmt("%.1f", cs.mean_length) + " / max " + std::to_string(cs.max_length) +
-         ", " + std::to_string(cs.self_intersecting) + " self-intersecting\n";
+         ", " + std::to_string(cs.self_intersecting) + " self-intersecting (at " +
+         std::to_string(cs.self_crossings) + " quads)\n";
     for (size_t c = 0; c < d.chords.chords.size(); ++c) {
       const Chord& ch = d.chords.chords[c];
       if (ch.self_intersecting)
@@ -168,6 +182,8 @@ nlohmann::json to_json(const SurfaceDiagnosis& d) {
                 {"sharp_convex", d.edges.sharp_convex},
                 {"sharp_concave", d.edges.sharp_concave},
                 {"flat", d.edges.flat}};
+  j["chords"]["self_crossings"] = cs.self_crossings;
+  j["path"] = mesh_path(d);
   return j;
 }
 

@@ -378,6 +378,32 @@ TEST_F(Cli, MixedOrientationIsReorientedAndMeshesTheSame) {
       << report.dump().substr(0, 400);
 }
 
+TEST_F(Cli, CheckTellsThePathAndCountsSelfCrossings) {
+  const std::string good = write("sphere.obj", gen::cubed_sphere_equiangular(2).surface);
+  Outcome g = run({"check", good, "--json", path("g.json")});
+  EXPECT_EQ(g.exit_code, 0) << g.err;
+  EXPECT_TRUE(contains(g.out, "path: dual cycle elimination")) << g.out;
+  // 8 quads, one chord through all of them, crossing itself at each quad it passes twice
+  const std::string bad = write(
+      "selfint.obj",
+      obj_text(test::radial_soup({{1, 1, 0}, {-1, 1, 0}, {-1, -1, 0}, {1, -1, 0}, {0, 0, 1}},
+                                 {{0, 3, 2, 1}, {0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}})));
+  Outcome b = run({"check", bad, "--json", path("b.json")});
+  EXPECT_EQ(b.exit_code, 2) << b.err;
+  const auto j = nlohmann::json::parse(slurp(path("b.json")));
+  const int crossings = j["chords"]["self_crossings"];
+  int listed = 0;
+  for (const auto& c : j["chords"]["self_intersecting"]) listed += static_cast<int>(c["crossings"].size());
+  EXPECT_GT(crossings, 0);
+  EXPECT_EQ(crossings, listed);
+  EXPECT_TRUE(contains(b.out, "path: none: 1 of 1 chords cross themselves, at " +
+                                  std::to_string(crossings) + " quads"))
+      << b.out;
+  EXPECT_TRUE(contains(j["path"].get<std::string>(), "not implemented")) << j.dump();
+  EXPECT_TRUE(contains(nlohmann::json::parse(slurp(path("g.json")))["path"].get<std::string>(),
+                       "dual cycle elimination"));
+}
+
 TEST_F(Cli, CheckReportsUnreadableFiles) {
   Outcome missing = run({"check", path("missing.obj")});
   EXPECT_NO_SIGNAL(missing);
