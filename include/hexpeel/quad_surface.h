@@ -62,4 +62,13 @@ Vec3 quad_centroid(const QuadSurface& surface, int32_t q);
 /// Signed volume enclosed by a closed surface (positive when outward oriented).
 double signed_volume(const QuadSurface& surface);
 
+/// Scale normalization: the k for which 2^k brings the largest extent of the points' bounding
+/// box into [1, 2), when that extent lies outside [2^-16, 2^16] (areas, determinants and
+/// tolerances then work on numbers of moderate size, whatever the units); 0 otherwise, and for
+/// no points or non-finite coordinates (which validation reports).
+int scale_exponent(const std::vector<Vec3>& points);
+/// Multiplies every coordinate by 2^k: exact, and undone exactly by -k, unless a result over-
+/// or underflows.
+void scale_points(std::vector<Vec3>& points, int k);
+
 }  // namespace hexpeel

@@ -31,6 +31,7 @@ enum class StatusCode {
   nonzero_genus,        ///< the surface is not a topological sphere
   odd_quad_count,       ///< no hex mesh has a boundary with an odd number of quads
   self_intersecting_chord, ///< a chord passes through a quad twice (method cannot handle it)
+  self_intersecting_surface, ///< two quads cut through or touch each other (bounds no solid)
   // meshing
   stuck,                ///< no feasible elimination left before the cube
   invalid_intrusion,    ///< a concave step's intrusion would not remove |side| hexes

@@ -22,6 +22,8 @@ struct ValidationParams {
   /// one face at a time) and warn, instead of rejecting the surface. A non-orientable surface is
   /// always rejected.
   bool reorient = true;
+  /// Refuse a surface whose quads cut through or touch each other (intersection.h).
+  bool check_self_intersection = true;
 };
 
 /// One problem found. Several may be found; the first error decides the status.

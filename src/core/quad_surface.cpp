@@ -4,6 +4,7 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <cmath>
 
 namespace hexpeel {
 
@@ -69,6 +70,27 @@ double signed_volume(const QuadSurface& surface) {
     vol += a.dot(b.cross(c)) + a.dot(c.cross(d));
   }
   return vol / 6.0;
+}
+
+int scale_exponent(const std::vector<Vec3>& points) {
+  if (points.empty()) return 0;
+  Vec3 lo = points.front(), hi = lo;
+  for (const Vec3& p : points) {
+    if (!p.allFinite()) return 0;
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  // Halves first: hi - lo itself may overflow near the largest doubles.
+  const double half_extent = (0.5 * hi - 0.5 * lo).maxCoeff();
+  if (!(half_extent > 0.0)) return 0;
+  const int e = std::ilogb(half_extent) + 1;  // extent = 2 * half_extent in [2^e, 2^(e+1))
+  return e < -16 || e >= 16 ? -e : 0;
+}
+
+void scale_points(std::vector<Vec3>& points, int k) {
+  if (k == 0) return;
+  for (Vec3& p : points)
+    for (int i = 0; i < 3; ++i) p[i] = std::ldexp(p[i], k);
 }
 
 }  // namespace hexpeel

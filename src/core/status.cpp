@@ -22,6 +22,7 @@ std::string_view to_string(StatusCode code) {
     case StatusCode::non_manifold_edge: return "non_manifold_edge";
     case StatusCode::non_manifold_vertex: return "non_manifold_vertex";
     case StatusCode::inconsistent_orientation: return "inconsistent_orientation";
+    case StatusCode::self_intersecting_surface: return "self_intersecting_surface";
     case StatusCode::multiple_components: return "multiple_components";
     case StatusCode::nonzero_genus: return "nonzero_genus";
     case StatusCode::odd_quad_count: return "odd_quad_count";

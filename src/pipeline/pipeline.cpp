@@ -595,6 +595,18 @@ bool better_result(const MeshResult& a, const MeshResult& b) {
 }
 
 MeshResult run_mesh(const PolygonSoup& soup, const MeshParams& params, const Context& ctx) {
+  // Far from unit size, the whole run works on the soup scaled by a power of two (exact), and
+  // what it returns is scaled back: the boundary vertices come back exactly as read.
+  if (const int k = scale_exponent(soup.points); k != 0) {
+    PolygonSoup scaled = soup;
+    scale_points(scaled.points, k);
+    MeshResult r = run_mesh(scaled, params, ctx);
+    scale_points(r.mesh.points, -k);
+    scale_points(r.diagnosis.validation.surface.points, -k);
+    scale_points(r.stuck_surface.points, -k);
+    for (WorstHex& w : r.quality.worst) w.centroid = std::ldexp(1.0, -k) * w.centroid;
+    return r;
+  }
   auto t = std::chrono::steady_clock::now();
   SurfaceDiagnosis diagnosis = diagnose_surface(soup, params.sharp_angle_deg, ctx, params.validation);
   const double check_s = seconds_since(t);

@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cmath>
 #include <iomanip>
 #include <limits>
 #include <numeric>
@@ -53,6 +54,20 @@ nlohmann::json number_or_null(double x) {
 
 QualityReport run_quality(const HexMesh& mesh, const QualityParams& params,
                           const QuadSurface* surface, const Context& ctx) {
+  // Far from unit size: measured on a copy scaled by a power of two (quality is scale-free),
+  // the centroids scaled back.
+  if (const int k = scale_exponent(mesh.points); k != 0) {
+    HexMesh scaled = mesh;
+    scale_points(scaled.points, k);
+    QuadSurface scaled_surface;
+    if (surface) {
+      scaled_surface = *surface;
+      scale_points(scaled_surface.points, k);
+    }
+    QualityReport r = run_quality(scaled, params, surface ? &scaled_surface : nullptr, ctx);
+    for (WorstHex& w : r.worst) w.centroid = std::ldexp(1.0, -k) * w.centroid;
+    return r;
+  }
   QualityReport r;
   const int32_t nh = mesh.num_hexes(), np = mesh.num_points();
   r.hexes = nh;

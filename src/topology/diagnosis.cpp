@@ -40,6 +40,15 @@ std::string fmt(const char* format, double x) {
 
 SurfaceDiagnosis diagnose_surface(const PolygonSoup& soup, double sharp_angle_deg,
                                   const Context& ctx, const ValidationParams& validation) {
+  // Far from unit size, the checks run on the soup scaled by a power of two (exact), and the
+  // surface returned is scaled back.
+  if (const int k = scale_exponent(soup.points); k != 0) {
+    PolygonSoup scaled = soup;
+    scale_points(scaled.points, k);
+    SurfaceDiagnosis d = diagnose_surface(scaled, sharp_angle_deg, ctx, validation);
+    scale_points(d.validation.surface.points, -k);
+    return d;
+  }
   SurfaceDiagnosis d;
   d.sharp_angle_deg = sharp_angle_deg;
   d.validation = run_validation(soup, validation, ctx);

@@ -14,8 +14,12 @@
 //      surface, the genus of each component (Euler characteristic) and the parity of the quad
 //      count (the boundary of a hex mesh has 6H - 2I quads, an even number).
 //   3. orientation: a surface that encloses a negative volume is flipped (warned) or rejected.
+//   4. geometry: quads that cut through or touch each other away from their shared vertices and
+//      edges (intersection.h) are refused in pairs.
 // Never crashes, whatever the soup: the checks read only what the earlier ones proved valid.
 #include "hexpeel/validation.h"
+
+#include "hexpeel/intersection.h"
 
 #include <Eigen/Geometry>
 
@@ -116,6 +120,7 @@ struct Validator {
   void build_surface();
   void check_topology();
   void check_orientation();
+  void check_self_intersection();
 };
 
 /// Readers guarantee well-formed offsets; a hand-built soup may not. Stop on the first bad one.
@@ -617,6 +622,27 @@ void Validator::check_orientation() {
        "); every quad has been reversed to face outward");
 }
 
+/// Stage 4: the quads must not meet except at the vertices and edges they share.
+void Validator::check_self_intersection() {
+  const SelfIntersections si = find_self_intersections(result.surface, 10);
+  if (si.total == 0) return;
+  std::string list;
+  std::vector<int32_t> faces;
+  for (const auto& [a, b] : si.pairs) {
+    list += (list.empty() ? "" : ", ") + std::to_string(a) + " and " + std::to_string(b);
+    keep_id(faces, a);
+    keep_id(faces, b);
+  }
+  if (si.total > static_cast<int64_t>(si.pairs.size()))
+    list += " and " + std::to_string(si.total - static_cast<int64_t>(si.pairs.size())) + " more pairs";
+  issue(StatusCode::self_intersecting_surface,
+        "the surface intersects itself: " +
+            plural(si.total, "pair of quads meets", "pairs of quads meet") +
+            " away from their shared vertices and edges (quads " + list +
+            "); it bounds no solid, so no hex mesh of it can be valid",
+        std::move(faces));
+}
+
 }  // namespace
 
 ValidationResult run_validation(const PolygonSoup& soup, const ValidationParams& params,
@@ -642,6 +668,8 @@ ValidationResult run_validation(const PolygonSoup& soup, const ValidationParams&
   val.check_topology();
   if (!r.issues.empty()) return finish();
   val.check_orientation();
+  if (!r.issues.empty() || !params.check_self_intersection) return finish();
+  val.check_self_intersection();
   return finish();
 }
 

@@ -744,6 +744,24 @@ TEST_F(Cli, ThreadCountDoesNotChangeTheOutput) {
   }
 }
 
+TEST_F(Cli, SelfIntersectingSurfaceIsRefusedByCheckAndMesh) {
+  // The 3x3x3 block's boundary with an inner top vertex pushed down through the bottom face.
+  PolygonSoup s = test::grid_soup(3);
+  for (Vec3& p : s.points)
+    if (p == Vec3(1, 1, 3)) p.z() = -0.5;
+  const std::string in = write("pushed.obj", obj_text(s));
+  Outcome c = run({"check", in});
+  EXPECT_NO_SIGNAL(c);
+  EXPECT_EQ(c.exit_code, 2) << c.err;
+  EXPECT_TRUE(contains(c.err, "self_intersecting_surface")) << c.err;
+  EXPECT_TRUE(contains(c.err, "intersects itself")) << c.err;
+  Outcome m = run({"mesh", in, "-o", path("out.vtk")});
+  EXPECT_NO_SIGNAL(m);
+  EXPECT_EQ(m.exit_code, 2) << m.err;
+  EXPECT_TRUE(contains(m.err, "intersects itself")) << m.err;
+  EXPECT_EQ(listing(), std::vector<std::string>{"pushed.obj"});
+}
+
 TEST_F(Cli, FailedMeshLeavesNoFileBehind) {
   // bad input
   const std::string bad = write("torus.obj", obj_text(test::torus_soup(8, 4)));

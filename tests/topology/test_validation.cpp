@@ -309,6 +309,62 @@ TEST(Validation, UnusedVerticesDroppedWithWarning) {
   }
 }
 
+/// The 3x3x3 block's boundary with its top-centre vertex pushed down through the bottom face.
+PolygonSoup pushed_through_cube(int32_t& pushed) {
+  PolygonSoup s = test::grid_soup(3);
+  pushed = -1;
+  for (int32_t v = 0; v < static_cast<int32_t>(s.points.size()); ++v)
+    if (s.points[v] == Vec3(1, 1, 3) || s.points[v] == Vec3(2, 2, 3)) pushed = v;  // an inner top vertex
+  s.points[pushed].z() = -0.5;
+  return s;
+}
+
+TEST(Validation, SurfacePushedThroughItselfIsRefused) {
+  int32_t pushed = -1;
+  const PolygonSoup s = pushed_through_cube(pushed);
+  ASSERT_GE(pushed, 0);
+  const ValidationResult r = run_validation(s);
+  ASSERT_EQ(r.status.code, StatusCode::self_intersecting_surface) << to_string(r.status);
+  EXPECT_TRUE(contains(r.status.message, "the surface intersects itself")) << r.status.message;
+  // Every quad named has the pushed vertex or lies on the bottom face it went through.
+  ASSERT_FALSE(r.issues[0].faces.empty());
+  bool around_pushed = false;
+  for (int32_t f : r.issues[0].faces) {
+    bool has_pushed = false, on_bottom = true;
+    for (int i = 0; i < 4; ++i) {
+      const int32_t v = s.indices[s.offsets[f] + i];
+      has_pushed = has_pushed || v == pushed;
+      on_bottom = on_bottom && s.points[v].z() == 0.0;
+    }
+    EXPECT_TRUE(has_pushed || on_bottom) << "quad " << f;
+    around_pushed = around_pushed || has_pushed;
+  }
+  EXPECT_TRUE(around_pushed);
+  ValidationParams off;
+  off.check_self_intersection = false;
+  EXPECT_TRUE(run_validation(s, off).status.ok());
+}
+
+TEST(Validation, SpheresWithAVertexPushedThroughAreRefusedAndIntactOnesAccepted) {
+  for (int n = 2; n <= 5; ++n) {
+    PolygonSoup s = test::grid_soup(n);
+    const Vec3 c(0.5 * n, 0.5 * n, 0.5 * n);
+    for (Vec3& p : s.points) p = c + (p - c).normalized();
+    SCOPED_TRACE("n = " + std::to_string(n));
+    EXPECT_TRUE(run_validation(s).status.ok());
+    for (int32_t v = 0; v < static_cast<int32_t>(s.points.size()); v += 7) {
+      PolygonSoup bad = s;
+      bad.points[v] = c - 1.3 * (s.points[v] - c);  // through the centre, out the other side
+      const ValidationResult r = run_validation(bad);
+      EXPECT_EQ(r.status.code, StatusCode::self_intersecting_surface) << "vertex " << v;
+    }
+    // Dented inwards without reaching the other side: still a valid surface.
+    PolygonSoup dented = s;
+    dented.points[0] = c + 0.7 * (s.points[0] - c);
+    EXPECT_TRUE(run_validation(dented).status.ok()) << to_string(run_validation(dented).status);
+  }
+}
+
 TEST(Validation, InwardCubeIsFlipped) {
   PolygonSoup s = cube_soup();
   for (int32_t f = 0; f < s.num_faces(); ++f) s = test::with_face_reversed(s, f);
