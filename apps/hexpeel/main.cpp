@@ -133,7 +133,7 @@ int cmd_mesh(const std::string& in, const std::string& out, const std::string& r
              const std::string& dump_stuck, const MeshParams& params, bool quiet) {
   if (!is_hex_mesh_extension(out))
     return report_error(Status::error(StatusCode::unsupported_format,
-                                      "output '" + out + "': use .vtk, .vtu, .mesh or .msh"));
+                                      "output '" + out + "': use .vtk, .vtu, .mesh, .msh, .inp, .exo or .e"));
   if (!dump_stuck.empty() && !is_surface_extension(dump_stuck))
     return report_error(Status::error(StatusCode::unsupported_format,
                                       "--dump-stuck '" + dump_stuck + "': use .obj or .off"));
@@ -313,7 +313,7 @@ int main(int argc, char** argv) {
 
   auto* mesh = app.add_subcommand("mesh", "Fill a quad surface with hexes by dual cycle elimination.");
   mesh->add_option("IN", in, "surface file (.obj .off .ply .mesh .msh .vtk)")->required();
-  mesh->add_option("-o,--output", out, "hex mesh to write (.vtk .vtu .mesh .msh)")->required();
+  mesh->add_option("-o,--output", out, "hex mesh to write (.vtk .vtu .mesh .msh .inp .exo .e)")->required();
   mesh->add_option("--report", report, "write a JSON report: quality, chords, steps, status, timings");
   mesh->add_option("--dump-stuck", dump_stuck, "when elimination gets stuck, write the surface it stopped at (.obj .off)");
   mesh->add_option("--sharp-angle", sharp_angle, "deviation from flat (degrees) above which an edge is sharp")

@@ -7,6 +7,10 @@
 // Hex meshes (read and write): .vtk (legacy ASCII)  .vtu (VTK XML, ASCII)  .mesh (MEDIT)
 //                              .msh (Gmsh 4.1 ASCII). Reading also takes what the surface readers
 //                              take: binary .vtk, binary/appended/zlib .vtu, Gmsh 2.2 and binary.
+// Hex meshes (write only, for FEA): .inp (Abaqus / CalculiX: C3D8 elements, node set BOUNDARY and
+//                              element-based surface BOUNDARY)  .exo .e (Exodus II: a HEX8 block,
+//                              node set and side set 1 "boundary"). The boundary groups hold every
+//                              hex face that occurs once in the mesh. See docs/formats.md.
 //
 // Readers never crash on any bytes: every problem comes back as a Status naming the line (or
 // byte offset) and what was expected. Writers write to a temporary file beside the target and
@@ -42,7 +46,8 @@ Status write_hex_mesh(const std::filesystem::path& path, const HexMesh& mesh);
 /// Writes `text` to `path` atomically (temporary file + rename). Used for reports too.
 Status write_text_file(const std::filesystem::path& path, const std::string& text);
 
-/// True when the extension names a hex-mesh format we write.
+/// True when the extension names a hex-mesh format we write (read_hex_mesh reads all of them but
+/// .inp, .exo and .e).
 bool is_hex_mesh_extension(const std::filesystem::path& path);
 /// True when the extension names a surface format we read.
 bool is_surface_extension(const std::filesystem::path& path);

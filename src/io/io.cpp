@@ -18,6 +18,7 @@ using io::CellKind;
 using io::CellSoup;
 
 using Reader = Status (*)(std::string_view, const std::string&, CellSoup&);
+using HexWriter = std::string (*)(const HexMesh&);
 
 std::string lower_extension(const std::filesystem::path& path) {
   std::string ext = path.extension().string();
@@ -48,6 +49,20 @@ Reader hex_reader(const std::string& ext) {
 
 constexpr const char* kSurfaceExtensions = ".obj .off .ply .mesh .msh .vtk .vtu";
 constexpr const char* kHexExtensions = ".vtk .vtu .mesh .msh";
+constexpr const char* kHexOutputExtensions = ".vtk .vtu .mesh .msh .inp .exo .e";
+
+/// The writer of a hex-mesh output format that returns the file content, or nullptr.
+HexWriter hex_text_writer(const std::string& ext) {
+  if (ext == ".vtk") return io::write_vtk_legacy;
+  if (ext == ".vtu") return io::write_vtu;
+  if (ext == ".mesh") return io::write_medit;
+  if (ext == ".msh") return io::write_gmsh;
+  if (ext == ".inp") return io::write_abaqus;
+  return nullptr;
+}
+
+/// Exodus II, which its library writes to a path.
+bool is_exodus_extension(const std::string& ext) { return ext == ".exo" || ext == ".e"; }
 
 Status unsupported(const std::filesystem::path& path, const char* what, const char* list) {
   return Status::error(StatusCode::unsupported_format,
@@ -90,7 +105,8 @@ Status check_corners(const CellSoup& soup, int64_t n, size_t c, const std::strin
 }  // namespace
 
 bool is_hex_mesh_extension(const std::filesystem::path& path) {
-  return hex_reader(lower_extension(path)) != nullptr;
+  const std::string ext = lower_extension(path);
+  return hex_text_writer(ext) != nullptr || is_exodus_extension(ext);
 }
 
 bool is_surface_extension(const std::filesystem::path& path) {
@@ -186,11 +202,9 @@ Status write_surface(const std::filesystem::path& path, const QuadSurface& surfa
 
 Status write_hex_mesh(const std::filesystem::path& path, const HexMesh& mesh) {
   const std::string ext = lower_extension(path);
-  if (ext == ".vtk") return io::write_file_atomic(path, io::write_vtk_legacy(mesh));
-  if (ext == ".vtu") return io::write_file_atomic(path, io::write_vtu(mesh));
-  if (ext == ".mesh") return io::write_file_atomic(path, io::write_medit(mesh));
-  if (ext == ".msh") return io::write_file_atomic(path, io::write_gmsh(mesh));
-  return unsupported(path, "hex mesh output", kHexExtensions);
+  if (const HexWriter writer = hex_text_writer(ext)) return io::write_file_atomic(path, writer(mesh));
+  if (is_exodus_extension(ext)) return io::write_exodus(path, mesh);
+  return unsupported(path, "hex mesh output", kHexOutputExtensions);
 }
 
 Status write_text_file(const std::filesystem::path& path, const std::string& text) {

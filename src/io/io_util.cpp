@@ -299,19 +299,36 @@ Status read_whole_file(const std::filesystem::path& path, std::string& out) {
   return Status::success();
 }
 
+std::filesystem::path temporary_path_beside(const std::filesystem::path& path) {
+  std::random_device rd;
+  std::string name = ".";
+  name += path.filename().string();
+  name += ".tmp";
+  name += std::to_string(::getpid());
+  name += '_';
+  name += std::to_string(rd());
+  return path.parent_path() / name;
+}
+
+Status rename_over(const std::filesystem::path& tmp, const std::filesystem::path& path) {
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    const std::string reason = std::strerror(errno);
+    ::unlink(tmp.c_str());
+    return Status::error(StatusCode::io_error,
+                         path.string() + ": cannot rename the temporary file over it: " + reason);
+  }
+  return Status::success();
+}
+
 Status write_file_atomic(const std::filesystem::path& path, std::string_view bytes) {
   auto fail = [&](const std::string& what) {
     return Status::error(StatusCode::io_error, path.string() + ": " + what);
   };
   if (path.filename().empty()) return fail("not a file name");
-  const std::filesystem::path dir = path.parent_path();
-  // A unique temporary name beside the target, so the final rename stays on one file system.
-  std::random_device rd;
   std::filesystem::path tmp;
   int fd = -1;
   for (int attempt = 0; attempt < 16 && fd < 0; ++attempt) {
-    const std::string suffix = ".tmp" + std::to_string(::getpid()) + "_" + std::to_string(rd());
-    tmp = dir / ("." + path.filename().string() + suffix);
+    tmp = temporary_path_beside(path);
     fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
     if (fd < 0 && errno != EEXIST) break;
   }
@@ -333,12 +350,7 @@ Status write_file_atomic(const std::filesystem::path& path, std::string_view byt
     ::unlink(tmp.c_str());
     return fail("write failed: " + reason);
   }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    const std::string reason = std::strerror(errno);
-    ::unlink(tmp.c_str());
-    return fail("cannot rename the temporary file over it: " + reason);
-  }
-  return Status::success();
+  return rename_over(tmp, path);
 }
 
 }  // namespace hexpeel::io

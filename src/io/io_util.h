@@ -162,5 +162,12 @@ void append_int(std::string& out, int64_t v);
 Status read_whole_file(const std::filesystem::path& path, std::string& out);
 /// Writes to a fresh temporary file beside `path`, then renames it over `path`.
 Status write_file_atomic(const std::filesystem::path& path, std::string_view bytes);
+/// A name for a temporary file beside `path` (same directory, so that renaming it over `path`
+/// stays on one file system): ".<file name>.tmp<pid>_<random>". The caller creates it exclusively
+/// and tries another name when it exists.
+std::filesystem::path temporary_path_beside(const std::filesystem::path& path);
+/// Renames the finished temporary file `tmp` over `path`; on failure removes `tmp` and returns an
+/// io_error naming `path`.
+Status rename_over(const std::filesystem::path& tmp, const std::filesystem::path& path);
 
 }  // namespace hexpeel::io
