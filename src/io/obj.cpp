@@ -1,12 +1,29 @@
 // Wavefront OBJ: reads `v` and `f` lines of a polygon surface, writes a quad surface.
 //
 // Reading: face corners may be written `i`, `i/t`, `i//n` or `i/t/n`; negative indices count
-// back from the last vertex defined so far. Comments (#) and every other statement (vt, vn, g, o,
-// s, usemtl, mtllib, l...) are ignored. A vertex may carry a fourth (w) or colour values: only
+// back from the last vertex defined so far. Comments (#) and every other statement of the OBJ
+// format (vt, vn, g, o, s, usemtl, mtllib, l...) are ignored; a line that starts with anything
+// else is an error naming it (random bytes or another format given the .obj extension). A vertex may carry a fourth (w) or colour values: only
 // x y z are kept. Indices are 1-based in the file; they are range-checked by io.cpp.
 #include "io/formats.h"
 
 namespace hexpeel::io {
+
+namespace {
+
+/// The statements of the OBJ format (Wavefront's specification) other than v and f.
+bool is_obj_keyword(std::string_view t) {
+  static constexpr std::string_view kKeywords[] = {
+      "vt", "vn", "vp", "l", "p", "g", "o", "s", "mg", "usemtl", "mtllib", "usemap", "maplib",
+      "cstype", "deg", "bmat", "step", "curv", "curv2", "surf", "parm", "trim", "hole", "scrv",
+      "sp", "end", "con", "bevel", "c_interp", "d_interp", "lod", "shadow_obj", "trace_obj",
+      "ctech", "stech", "call", "csh", "res", "bsp", "bzp", "cdc", "cdp"};
+  for (std::string_view k : kKeywords)
+    if (t == k) return true;
+  return false;
+}
+
+}  // namespace
 
 Status read_obj(std::string_view data, const std::string& name, CellSoup& out) {
   TextCursor cur(data, name, '#');
@@ -45,6 +62,9 @@ Status read_obj(std::string_view data, const std::string& name, CellSoup& out) {
       }
       if (face.empty()) return cur.error("face has no vertices");
       out.add_cell(CellKind::polygon, face.data(), face.size(), at_line(line));
+    } else if (!is_obj_keyword(tok)) {
+      return cur.error("expected an OBJ statement ('v', 'f', 'vn', 'g', ...) or a comment, found " +
+                       quoted(tok) + "; is this an OBJ file?");
     }
     cur.skip_line();
   }

@@ -89,6 +89,33 @@ TEST(SurfaceReaders, SyntaxErrorsNameTheLine) {
   EXPECT_EQ(read_surface(dir / "neg.msh", soup).code, StatusCode::parse_error);
 }
 
+TEST(SurfaceReaders, ObjOfAnotherFormatSaysSo) {
+  const test_io::ScratchDir scratch_dir("surface_not_obj");
+  const auto& dir = scratch_dir.path();
+  PolygonSoup soup;
+  // plain text, an OFF file and binary bytes given the .obj extension: the line is named
+  test_io::write_bytes(dir / "text.obj", "# fine\nv 0 0 0\nhello world\n");
+  Status s = read_surface(dir / "text.obj", soup);
+  EXPECT_EQ(s.code, StatusCode::parse_error);
+  EXPECT_NE(s.message.find("text.obj:3:"), std::string::npos) << s.message;
+  EXPECT_NE(s.message.find("'hello'; is this an OBJ file?"), std::string::npos) << s.message;
+  test_io::write_bytes(dir / "off.obj", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  s = read_surface(dir / "off.obj", soup);
+  EXPECT_EQ(s.code, StatusCode::parse_error);
+  EXPECT_NE(s.message.find("off.obj:1:"), std::string::npos) << s.message;
+  test_io::write_bytes(dir / "bin.obj", std::string("\x7f" "ELF\x02\x01\x01\0\0\0", 10));
+  s = read_surface(dir / "bin.obj", soup);
+  EXPECT_EQ(s.code, StatusCode::parse_error);
+  EXPECT_NE(s.message.find("is this an OBJ file?"), std::string::npos) << s.message;
+  // every statement of the format is still accepted and ignored
+  test_io::write_bytes(dir / "full.obj",
+                       "mtllib a.mtl\no part\ng side\ns 1\nusemtl steel\nv 0 0 0\nv 1 0 0\n"
+                       "v 1 1 0\nvt 0 0\nvn 0 0 1\nvp 0.5\nl 1 2\nf 1/1/1 2/1/1 3/1/1\n");
+  s = read_surface(dir / "full.obj", soup);
+  EXPECT_TRUE(s.ok()) << to_string(s);
+  EXPECT_EQ(soup.num_faces(), 1);
+}
+
 TEST(SurfaceReaders, EmptyAndUnknownFiles) {
   const test_io::ScratchDir scratch_dir("surface_empty");
   const auto& dir = scratch_dir.path();
