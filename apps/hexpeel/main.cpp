@@ -24,6 +24,7 @@
 #include "hexpeel/pipeline.h"
 #include "hexpeel/quality.h"
 
+#include <algorithm>
 #include <CLI/CLI.hpp>
 #include <tbb/global_control.h>
 
@@ -160,6 +161,17 @@ int cmd_mesh(const std::string& in, const std::string& out, const std::string& r
   if (!report.empty()) {
     nlohmann::json j = to_json(r);
     j["timings_s"]["read"] = read_s;
+    // The budgets, passes and retries this run used (what --effort and their options set).
+    j["params"] = {{"plan_budget_s", params.planner.budget_s},
+                   {"improve_budget_s", params.planner.improve_budget_s},
+                   {"stuck_fill_budget_s", params.terminal.total_budget_s},
+                   {"quality_passes", params.untangle.quality_passes},
+                   {"final_polish_runs", params.untangle.final_polish_runs},
+                   {"final_polish_rounds", params.untangle.final_polish_rounds},
+                   {"alternatives", params.alternatives},
+                   {"alternatives_always", params.alternatives_always},
+                   {"repair_rounds", params.repair_rounds},
+                   {"intrusion_flip_rounds", params.intrusion_flip_rounds}};
     j["timings_s"]["write"] = write_s;
     Status w = write_text_file(report, j.dump(2) + "\n");
     if (!w.ok()) return report_error(w);
@@ -290,6 +302,29 @@ int cmd_quality(const std::string& mesh_path, const std::string& surface_path,
   why.resize(why.size() - 2);
   std::fprintf(stderr, "hexpeel: error: %s: %s\n", mesh_path.c_str(), why.c_str());
   return 2;
+}
+
+/// --effort: the budgets, passes and retries of a preset, each unless its own option was given.
+/// "default" changes nothing.
+void apply_effort(const std::string& effort, const CLI::App& mesh, MeshParams& p) {
+  auto set = [&](const char* option, auto& field, auto value) {
+    if (mesh.count(option) == 0) field = value;
+  };
+  if (effort == "fast") {
+    set("--stuck-fill-budget", p.terminal.total_budget_s, 3.0);
+    set("--quality-passes", p.untangle.quality_passes, 1);
+    set("--final-polish-runs", p.untangle.final_polish_runs, 1);
+    set("--final-polish-rounds", p.untangle.final_polish_rounds, 1);
+    set("--alternatives", p.alternatives, 1);
+    set("--repair-rounds", p.repair_rounds, 1);
+    set("--intrusion-flip-rounds", p.intrusion_flip_rounds, 1);
+  } else if (effort == "best") {
+    set("--plan-budget", p.planner.budget_s, 60.0);
+    set("--improve-budget", p.planner.improve_budget_s, 20.0);
+    set("--quality-passes", p.untangle.quality_passes, 5);
+    set("--final-polish-rounds", p.untangle.final_polish_rounds, 3);
+    set("--alternatives-always", p.alternatives_always, true);
+  }
 }
 
 }  // namespace
@@ -490,6 +525,28 @@ int main(int argc, char** argv) {
   mesh->add_option("--threads", threads, threads_help)->check(CLI::Range(0, 1024))->capture_default_str();
   mesh->add_flag("-q,--quiet", quiet, "print only warnings and errors");
 
+  std::string effort = "default";
+  mesh->add_option("--effort", effort,
+                   "fast: smaller budgets, fewer passes and retries; default; best: larger budgets, "
+                   "more passes, every elimination order tried (options given explicitly win)")
+      ->check(CLI::IsMember({"fast", "default", "best"}))->capture_default_str();
+  // The everyday options; the others (tuning of the search, pillow, optimizer and retries) are
+  // listed by --help-all only.
+  const bool help_all = std::any_of(argv + 1, argv + argc, [](const char* a) {
+    return std::string_view(a) == "--help-all";
+  });
+  mesh->set_help_all_flag("--help-all", "print every option, the expert ones too, and exit");
+  for (CLI::Option* o : mesh->get_options()) {
+    static const char* const kEveryday[] = {"help", "help-all", "output", "report", "dump-stuck",
+                                            "sharp-angle", "effort", "plan-budget", "pillow",
+                                            "threads", "quiet"};
+    const auto& lnames = o->get_lnames();
+    const bool everyday = o->get_positional() || std::any_of(std::begin(kEveryday), std::end(kEveryday), [&](const char* e) {
+      return std::find(lnames.begin(), lnames.end(), e) != lnames.end();
+    });
+    if (!everyday) o->group(help_all ? "Expert options (see docs/cli.md)" : "");
+  }
+
   auto* quality = app.add_subcommand("quality", "Report the quality of any hex mesh (.vtk .vtu .mesh .msh).");
   quality->add_option("MESH", in, "hex mesh file")->required();
   quality->add_option("--surface", surface, "also check that the mesh boundary equals this surface");
@@ -531,6 +588,7 @@ int main(int argc, char** argv) {
       order.concave_waits_for_enclosed = !no_concave_waits;
       params.reconstruction.fallback_to_extrusion = !strict_intrusion;
       params.intrusion_cover = !no_intrusion_cover;
+      apply_effort(effort, *mesh, params);
       return cmd_mesh(in, out, report, dump_stuck, params, quiet);
     }
     if (*quality) return cmd_quality(in, surface, json_out);

@@ -702,6 +702,44 @@ TEST_F(Cli, MeshWithInvertedHexesExitsFive) {
   EXPECT_EQ(ok.exit_code, 0) << ok.err;
 }
 
+TEST_F(Cli, EffortPresets) {
+  const std::string in = write("sphere.obj", gen::cubed_sphere_equiangular(3).surface);
+  Outcome plain = run({"mesh", in, "-o", path("plain.vtk"), "--quiet", "--report", path("plain.json")});
+  Outcome def = run({"mesh", in, "-o", path("default.vtk"), "--quiet", "--effort", "default"});
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  ASSERT_EQ(def.exit_code, 0) << def.err;
+  EXPECT_TRUE(slurp(path("plain.vtk")) == slurp(path("default.vtk")));  // default changes nothing
+  const auto p = nlohmann::json::parse(slurp(path("plain.json")))["params"];
+  EXPECT_EQ(p["plan_budget_s"], 30.0);
+  EXPECT_EQ(p["alternatives"], 3);
+  // fast: its preset, except what is given explicitly
+  Outcome fast = run({"mesh", in, "-o", path("fast.vtk"), "--quiet", "--effort", "fast",
+                      "--alternatives", "2", "--report", path("fast.json")});
+  ASSERT_EQ(fast.exit_code, 0) << fast.err;
+  const auto f = nlohmann::json::parse(slurp(path("fast.json")));
+  EXPECT_EQ(f["params"]["final_polish_runs"], 1);
+  EXPECT_EQ(f["params"]["quality_passes"], 1);
+  EXPECT_EQ(f["params"]["alternatives"], 2);
+  EXPECT_EQ(f["scaled_jacobian"]["count_nonpositive"], 0);
+  Outcome best = run({"mesh", in, "-o", path("best.vtk"), "--quiet", "--effort", "best",
+                      "--report", path("best.json")});
+  ASSERT_EQ(best.exit_code, 0) << best.err;
+  const auto b = nlohmann::json::parse(slurp(path("best.json")));
+  EXPECT_EQ(b["params"]["alternatives_always"], true);
+  EXPECT_EQ(b["params"]["quality_passes"], 5);
+  EXPECT_GE(b["scaled_jacobian"]["min"].get<double>(), f["scaled_jacobian"]["min"].get<double>() - 1e-9);
+  Outcome bad = run({"mesh", in, "-o", path("x.vtk"), "--effort", "extreme"});
+  EXPECT_EQ(bad.exit_code, 1) << bad.err;
+  // the everyday help is short; --help-all lists the expert options too
+  Outcome help = run({"mesh", "--help"});
+  Outcome all = run({"mesh", "--help-all"});
+  EXPECT_EQ(help.exit_code, 0);
+  EXPECT_FALSE(contains(help.out, "--final-polish-softmin")) << help.out;
+  EXPECT_TRUE(contains(help.out, "--effort")) << help.out;
+  EXPECT_TRUE(contains(all.out, "--final-polish-softmin")) << all.out;
+  EXPECT_LE(std::count(help.out.begin(), help.out.end(), '\n'), 40);
+}
+
 TEST_F(Cli, MeshIsDeterministic) {
   const std::string in = write("sphere.obj", gen::cubed_sphere_equiangular(3).surface);
   for (const char* ext : {".vtk", ".vtu", ".mesh", ".msh"}) {
