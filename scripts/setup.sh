@@ -11,6 +11,7 @@ PACKAGES=(
   libexodusii-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-numpy python3-vtk9 python3-meshio python3-netcdf4
+  pybind11-dev python3-dev
 )
 
 if [[ "${1:-}" != "--no-install" ]]; then
@@ -23,6 +24,9 @@ fi
 
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
 cmake --build build --parallel
+# The Python module: `python3 -c "import hexpeel"` finds it in build/python (docs/python.md).
+site=$(/usr/bin/python3 -m site --user-site)
+mkdir -p "$site" && echo "$PWD/build/python" > "$site/hexpeel.pth"
 
 mkdir -p out
 ./build/hexpeel mesh examples/stairs.obj -o out/stairs.vtk --report out/stairs.json

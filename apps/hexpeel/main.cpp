@@ -162,16 +162,7 @@ int cmd_mesh(const std::string& in, const std::string& out, const std::string& r
     nlohmann::json j = to_json(r);
     j["timings_s"]["read"] = read_s;
     // The budgets, passes and retries this run used (what --effort and their options set).
-    j["params"] = {{"plan_budget_s", params.planner.budget_s},
-                   {"improve_budget_s", params.planner.improve_budget_s},
-                   {"stuck_fill_budget_s", params.terminal.total_budget_s},
-                   {"quality_passes", params.untangle.quality_passes},
-                   {"final_polish_runs", params.untangle.final_polish_runs},
-                   {"final_polish_rounds", params.untangle.final_polish_rounds},
-                   {"alternatives", params.alternatives},
-                   {"alternatives_always", params.alternatives_always},
-                   {"repair_rounds", params.repair_rounds},
-                   {"intrusion_flip_rounds", params.intrusion_flip_rounds}};
+    j["params"] = effort_to_json(params);
     j["timings_s"]["write"] = write_s;
     Status w = write_text_file(report, j.dump(2) + "\n");
     if (!w.ok()) return report_error(w);

@@ -163,4 +163,8 @@ MeshResult run_mesh(const PolygonSoup& soup, const MeshParams& params = {}, cons
 /// same_plan_as, kept}].
 nlohmann::json to_json(const MeshResult& result);
 
+/// The budgets, passes and retries of `params` (what the CLI's --effort presets set), for the
+/// report's "params" section.
+nlohmann::json effort_to_json(const MeshParams& params);
+
 }  // namespace hexpeel

@@ -908,4 +908,17 @@ nlohmann::json to_json(const MeshResult& r) {
   return j;
 }
 
+nlohmann::json effort_to_json(const MeshParams& p) {
+  return {{"plan_budget_s", p.planner.budget_s},
+          {"improve_budget_s", p.planner.improve_budget_s},
+          {"stuck_fill_budget_s", p.terminal.total_budget_s},
+          {"quality_passes", p.untangle.quality_passes},
+          {"final_polish_runs", p.untangle.final_polish_runs},
+          {"final_polish_rounds", p.untangle.final_polish_rounds},
+          {"alternatives", p.alternatives},
+          {"alternatives_always", p.alternatives_always},
+          {"repair_rounds", p.repair_rounds},
+          {"intrusion_flip_rounds", p.intrusion_flip_rounds}};
+}
+
 }  // namespace hexpeel
