@@ -510,8 +510,8 @@ void Validator::check_topology() {
     }
     // Only a surface that is otherwise a closed manifold is re-oriented; then it is checked
     // again from the start, as if it had been given that way.
+    std::sort(minority.begin(), minority.end());
     if (orientable && params.reorient && result.issues.empty()) {
-      std::sort(minority.begin(), minority.end());
       Listing rev;
       for (int32_t q : minority) {
         std::swap(result.surface.quads[q][1], result.surface.quads[q][3]);
@@ -529,7 +529,6 @@ void Validator::check_topology() {
     if (!orientable) {
       hint = "; the surface is not orientable";
     } else {
-      std::sort(minority.begin(), minority.end());
       Listing rev;
       for (int32_t q : minority) rev.add(std::to_string(q));
       hint = std::string("; reversing quad") + (rev.total == 1 ? " " : "s ") + rev.text() +
