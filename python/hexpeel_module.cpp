@@ -188,7 +188,7 @@ std::unique_ptr<tbb::global_control> thread_limit(int threads) {
 }
 
 py::tuple mesh(const py::object& points, const py::object& quads, double sharp_angle,
-               double plan_budget, int threads) {
+               double plan_budget, int threads, bool repair_surface) {
   check_sharp_angle(sharp_angle);
   if (!(plan_budget >= 0.0) || !std::isfinite(plan_budget))
     fail_argument("plan_budget must be a finite number >= 0");
@@ -196,6 +196,7 @@ py::tuple mesh(const py::object& points, const py::object& quads, double sharp_a
   MeshParams params;
   params.sharp_angle_deg = sharp_angle;
   params.planner.budget_s = plan_budget;
+  params.repair_surface = repair_surface;
   Warnings warnings;
   MeshResult r;
   {
@@ -289,7 +290,9 @@ PYBIND11_MODULE(_hexpeel, m) {
 
   m.def("mesh", &mesh, py::arg("points"), py::arg("quads"), py::kw_only(),
         py::arg("sharp_angle") = 60.0, py::arg("plan_budget") = 30.0, py::arg("threads") = 0,
-        "mesh(points, quads, *, sharp_angle=60.0, plan_budget=30.0, threads=0)\n--\n\n"
+        py::arg("repair_surface") = false,
+        "mesh(points, quads, *, sharp_angle=60.0, plan_budget=30.0, threads=0,\n"
+        "     repair_surface=False)\n--\n\n"
         "-> (points, hexes, report)\n\n"
         "Fills a closed genus-0 all-quad surface with hexahedra (as `hexpeel mesh`).\n\n"
         "points: (N, 3) float64 vertex coordinates; quads: (M, 4) integer 0-based vertex ids.\n"
@@ -300,6 +303,9 @@ PYBIND11_MODULE(_hexpeel, m) {
         "sharp_angle: degrees from flat above which an edge is sharp, in (0, 180);\n"
         "plan_budget: budget of the elimination-order search (deterministic work units);\n"
         "threads: at most this many threads (0 = one per core); the result is the same.\n"
+        "repair_surface: refine a surface with self-crossing chords or an odd count and\n"
+        "mesh that (`--repair-surface`): the hexes' boundary is the refined surface, the\n"
+        "input vertices come first; report['repair'] says what changed.\n"
         "The GIL is released while meshing. Raises hexpeel.Error.");
   m.def("check", &check, py::arg("points"), py::arg("quads"), py::kw_only(),
         py::arg("sharp_angle") = 60.0,

@@ -25,6 +25,7 @@
 #include "hexpeel/quality.h"
 
 #include <algorithm>
+#include <filesystem>
 #include <CLI/CLI.hpp>
 #include <tbb/global_control.h>
 
@@ -131,13 +132,20 @@ int cmd_check(const std::string& in, double sharp_angle, const std::string& json
 }
 
 int cmd_mesh(const std::string& in, const std::string& out, const std::string& report,
-             const std::string& dump_stuck, const MeshParams& params, bool quiet) {
+             const std::string& dump_stuck, const std::string& repaired_out,
+             const MeshParams& params, bool quiet) {
   if (!is_hex_mesh_extension(out))
     return report_error(Status::error(StatusCode::unsupported_format,
                                       "output '" + out + "': use .vtk, .vtu, .mesh, .msh, .inp, .exo or .e"));
   if (!dump_stuck.empty() && !is_surface_extension(dump_stuck))
     return report_error(Status::error(StatusCode::unsupported_format,
                                       "--dump-stuck '" + dump_stuck + "': use .obj or .off"));
+  if (!repaired_out.empty() && !is_surface_extension(repaired_out))
+    return report_error(Status::error(StatusCode::unsupported_format,
+                                      "--repaired-surface '" + repaired_out + "': use .obj or .off"));
+  if (!repaired_out.empty() && !params.repair_surface)
+    return report_error(Status::error(StatusCode::unsupported_format,
+                                      "--repaired-surface needs --repair-surface"));
   Progress progress;
   progress.enabled = !quiet;
   Context ctx = make_context(&progress, quiet);
@@ -155,6 +163,12 @@ int cmd_mesh(const std::string& in, const std::string& out, const std::string& r
   if (r.status.ok()) {
     t = Clock::now();
     Status w = write_hex_mesh(out, r.mesh);
+    if (w.ok() && !repaired_out.empty()) {
+      // The mesh's boundary: the repaired surface, or the input itself when it needed none.
+      w = write_surface(repaired_out, r.repair.applied ? r.repaired_surface
+                                                       : r.diagnosis.validation.surface);
+      if (!w.ok()) std::filesystem::remove(out);
+    }
     write_s = seconds_since(t);
     if (!w.ok()) r.status = w;
   }
@@ -325,7 +339,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "hexpeel 0.1.0");
   app.require_subcommand(1);
 
-  std::string in, out, report, dump_stuck, json_out, surface;
+  std::string in, out, report, dump_stuck, json_out, surface, repaired_out;
   double sharp_angle = 60.0;
   bool quiet = false;
   MeshParams params;
@@ -341,6 +355,12 @@ int main(int argc, char** argv) {
   mesh->add_option("IN", in, "surface file (.obj .off .ply .mesh .msh .vtk)")->required();
   mesh->add_option("-o,--output", out, "hex mesh to write (.vtk .vtu .mesh .msh .inp .exo .e)")->required();
   mesh->add_option("--report", report, "write a JSON report: quality, chords, steps, status, timings");
+  mesh->add_flag("--repair-surface", params.repair_surface,
+                 "a surface with a self-crossing chord or an odd quad count is refined into one "
+                 "hexpeel can mesh (input vertices kept, every quad split into 4 or 6) and that "
+                 "is meshed; see docs/cli.md");
+  mesh->add_option("--repaired-surface", repaired_out,
+                   "with --repair-surface: also write the mesh's boundary surface (.obj .off)");
   mesh->add_option("--dump-stuck", dump_stuck, "when elimination gets stuck, write the surface it stopped at (.obj .off)");
   mesh->add_option("--sharp-angle", sharp_angle, "deviation from flat (degrees) above which an edge is sharp")
       ->check(CLI::Range(0.0, 180.0))->capture_default_str();
@@ -529,6 +549,7 @@ int main(int argc, char** argv) {
   mesh->set_help_all_flag("--help-all", "print every option, the expert ones too, and exit");
   for (CLI::Option* o : mesh->get_options()) {
     static const char* const kEveryday[] = {"help", "help-all", "output", "report", "dump-stuck",
+                                            "repair-surface", "repaired-surface",
                                             "sharp-angle", "effort", "plan-budget", "pillow",
                                             "threads", "quiet"};
     const auto& lnames = o->get_lnames();
@@ -580,7 +601,7 @@ int main(int argc, char** argv) {
       params.reconstruction.fallback_to_extrusion = !strict_intrusion;
       params.intrusion_cover = !no_intrusion_cover;
       apply_effort(effort, *mesh, params);
-      return cmd_mesh(in, out, report, dump_stuck, params, quiet);
+      return cmd_mesh(in, out, report, dump_stuck, repaired_out, params, quiet);
     }
     if (*quality) return cmd_quality(in, surface, json_out);
   } catch (const std::bad_alloc&) {

@@ -11,6 +11,7 @@
 #include "hexpeel/pillow.h"
 #include "hexpeel/quality.h"
 #include "hexpeel/reconstruction.h"
+#include "hexpeel/surface_repair.h"
 #include "hexpeel/terminal.h"
 #include "hexpeel/untangle.h"
 
@@ -22,6 +23,10 @@ struct MeshParams {
   double sharp_angle_deg = 60.0;  ///< deviation from flat (degrees, in (0, 180)) that makes an edge sharp
   ValidationParams validation;
   EliminationParams elimination;  ///< its `order` rules serve the planner too
+  /// A surface with a chord that crosses itself or an odd quad count is refined into one
+  /// without (surface_repair.h) and that is meshed: the mesh's boundary is the repaired
+  /// surface. Off: such a surface is refused.
+  bool repair_surface = false;
   bool search = true;             ///< plan with the search portfolio (planner.h); false = plain greedy
   PlannerParams planner;          ///< budget, seed, side rule (its `order` is taken from `elimination`)
   TerminalParams terminal;        ///< filling the surface elimination got stuck on
@@ -140,6 +145,8 @@ struct MeshResult {
                                  ///< hexes in the same order, its own vertex ids
   QualityReport quality;         ///< when status ok
   QuadSurface stuck_surface;     ///< when elimination got stuck: the surface it stopped at
+  SurfaceRepairStats repair;     ///< MeshParams::repair_surface: what the repair changed
+  QuadSurface repaired_surface;  ///< ... and the surface it made (the mesh's boundary)
   MeshTimings timings;
   OrderParams method;            ///< the elimination order (method and rules) this run used
   std::vector<OrderTry> tries;   ///< every order tried, the given one first (empty when the

@@ -24,6 +24,8 @@ struct ValidationParams {
   bool reorient = true;
   /// Refuse a surface whose quads cut through or touch each other (intersection.h).
   bool check_self_intersection = true;
+  /// Accept an odd number of quads (for surface repair, which makes the count even).
+  bool allow_odd = false;
 };
 
 /// One problem found. Several may be found; the first error decides the status.

@@ -23,7 +23,7 @@ def mesh_meshio(surface, **options):
     Meshes a meshio.Mesh surface: its "quad" cells (every "quad" block, in order; other cell
     blocks are ignored) over its points. Returns a meshio.Mesh with the hex points and one
     "hexahedron" cell block (VTK corner order). `options` are hexpeel.mesh's keyword options
-    (sharp_angle, plan_budget, threads); the report dict is the result's attribute
+    (sharp_angle, plan_budget, threads, repair_surface); the report dict is the result's attribute
     `hexpeel_report`.
     Raises hexpeel.Error (code "invalid_argument" when the mesh has no "quad" cells).
     """

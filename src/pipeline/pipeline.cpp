@@ -594,6 +594,38 @@ bool better_result(const MeshResult& a, const MeshResult& b) {
   return a.quality.sj_min > b.quality.sj_min;
 }
 
+/// MeshParams::repair_surface: the surface of `diagnosis` refined (surface_repair.h) and meshed.
+static MeshResult mesh_repaired(const SurfaceDiagnosis& diagnosis, const MeshParams& params,
+                         const Context& ctx, double check_s) {
+  const auto t = std::chrono::steady_clock::now();
+  SurfaceRepair rep = repair_surface(diagnosis.validation.surface);
+  if (!rep.status.ok()) {
+    MeshResult r;
+    r.method = params.elimination.order;
+    r.status = rep.status;
+    r.diagnosis = diagnosis;
+    r.repair = rep.stats;
+    r.timings.check_s = check_s + seconds_since(t);
+    return r;
+  }
+  const SurfaceRepairStats& st = rep.stats;
+  ctx.warn("surface repaired (--repair-surface): " + std::to_string(st.input_quads) + " quads" +
+           (st.input_odd ? " (odd)" : "") + " with " + std::to_string(st.input_self_crossings) +
+           " self-crossing" + (st.input_self_crossings == 1 ? "" : "s") + " -> " +
+           std::to_string(st.output_quads) + " quads (" + std::to_string(st.six_split.size()) +
+           " split into six, the rest into four), every chord simple; the mesh's boundary is "
+           "the repaired surface, not the input");
+  const double repair_s = seconds_since(t);
+  MeshParams inner = params;
+  inner.repair_surface = false;
+  inner.validation.allow_odd = false;
+  MeshResult r = run_mesh(to_polygon_soup(rep.surface), inner, ctx);
+  r.timings.check_s += check_s + repair_s;  // the input's check and the repair
+  r.repair = rep.stats;
+  r.repaired_surface = std::move(rep.surface);
+  return r;
+}
+
 MeshResult run_mesh(const PolygonSoup& soup, const MeshParams& params, const Context& ctx) {
   // Far from unit size, the whole run works on the soup scaled by a power of two (exact), and
   // what it returns is scaled back: the boundary vertices come back exactly as read.
@@ -604,12 +636,19 @@ MeshResult run_mesh(const PolygonSoup& soup, const MeshParams& params, const Con
     scale_points(r.mesh.points, -k);
     scale_points(r.diagnosis.validation.surface.points, -k);
     scale_points(r.stuck_surface.points, -k);
+    scale_points(r.repaired_surface.points, -k);
     for (WorstHex& w : r.quality.worst) w.centroid = std::ldexp(1.0, -k) * w.centroid;
     return r;
   }
   auto t = std::chrono::steady_clock::now();
-  SurfaceDiagnosis diagnosis = diagnose_surface(soup, params.sharp_angle_deg, ctx, params.validation);
+  ValidationParams validation = params.validation;
+  validation.allow_odd = validation.allow_odd || params.repair_surface;
+  SurfaceDiagnosis diagnosis = diagnose_surface(soup, params.sharp_angle_deg, ctx, validation);
   const double check_s = seconds_since(t);
+  if (params.repair_surface && diagnosis.validation.status.ok() &&
+      (diagnosis.status.code == StatusCode::self_intersecting_chord ||
+       diagnosis.validation.surface.num_quads() % 2 != 0))
+    return mesh_repaired(diagnosis, params, ctx, check_s);
   if (!diagnosis.status.ok()) {
     MeshResult r;
     r.method = params.elimination.order;
@@ -702,6 +741,7 @@ nlohmann::json to_json(const MeshResult& r) {
   j["status"] = std::string(to_string(r.status.code));
   j["message"] = r.status.message;
   j["input"] = to_json(r.diagnosis);
+  if (r.repair.applied || r.repair.input_quads > 0) j["repair"] = to_json(r.repair);
   const ChordStats& cs = r.diagnosis.chord_stats;
   j["chords"] = {{"count", cs.count},
                  {"min_length", cs.min_length},

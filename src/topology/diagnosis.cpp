@@ -104,7 +104,8 @@ std::string mesh_path(const SurfaceDiagnosis& d) {
          " chords cross themselves, at " + std::to_string(cs.self_crossings) + " quads" +
          (odd ? " (an odd quad count forces one)" : "") +
          "; hexpeel does not yet mesh such a surface with its quads kept (the shelling path is "
-         "not implemented): remesh it so that every chord is simple";
+         "not implemented): remesh it so that every chord is simple, or let `hexpeel mesh "
+         "--repair-surface` refine it (its boundary is then the refined surface)";
 }
 
 std::string to_text(const SurfaceDiagnosis& d) {

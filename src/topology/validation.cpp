@@ -590,11 +590,11 @@ void Validator::check_topology() {
                            "handles or tunnels cannot be meshed by dual cycle elimination",
           std::move(handle_quads));
 
-  if (nq % 2 != 0)
+  if (nq % 2 != 0 && !params.allow_odd)
     issue(StatusCode::odd_quad_count,
           std::to_string(nq) +
               " quads: the boundary of any hex mesh has an even number of quads, so no hex "
-              "mesh can exist");
+              "mesh can exist (`hexpeel mesh --repair-surface` refines it into an even surface)");
 }
 
 /// Stage 3: outward orientation (the right-hand normals must point out of the enclosed volume).

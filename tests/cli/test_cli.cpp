@@ -823,6 +823,37 @@ TEST_F(Cli, FailedMeshLeavesNoFileBehind) {
   EXPECT_EQ(listing(), (std::vector<std::string>{"cube.obj", "torus.obj"}));
 }
 
+TEST_F(Cli, RepairSurfaceMeshesRefusedSurfacesAndWritesTheBoundary) {
+  const std::string in = write("odd.obj", obj_text(test::prism_radial_soup()));
+  // refused without the option, and the message names it
+  Outcome r = run({"mesh", in, "-o", path("out.vtk")});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_TRUE(contains(r.err, "--repair-surface")) << r.err;
+  // --repaired-surface alone is a usage error, before anything is read or written
+  r = run({"mesh", in, "-o", path("out.vtk"), "--repaired-surface", path("rep.obj")});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_TRUE(contains(r.err, "needs --repair-surface")) << r.err;
+  EXPECT_EQ(listing(), std::vector<std::string>{"odd.obj"});
+  // with it: the mesh, the repaired surface and a report that says what changed
+  r = run({"mesh", in, "-o", path("out.vtk"), "--repair-surface", "--repaired-surface",
+           path("rep.obj"), "--report", path("r.json")});
+  EXPECT_NO_SIGNAL(r);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(contains(r.err, "surface repaired")) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(slurp(path("r.json")));
+  EXPECT_EQ(j.at("repair").at("input_quads"), 9);
+  EXPECT_EQ(j.at("repair").at("input_odd"), true);
+  EXPECT_EQ(j.at("repair").at("quads_changed"), 9);
+  // the mesh's boundary is the repaired surface, exactly
+  r = run({"quality", path("out.vtk"), "--surface", path("rep.obj")});
+  EXPECT_EQ(r.exit_code, 0) << r.err << r.out;
+  EXPECT_TRUE(contains(r.out, "topological ball: yes")) << r.out;
+  EXPECT_TRUE(contains(r.out, "hexes with SJ <= 0: 0")) << r.out;
+  EXPECT_TRUE(contains(r.out, "boundary equals surface: yes")) << r.out;
+  r = run({"check", path("rep.obj")});
+  EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
+}
+
 TEST_F(Cli, MeshRejectsUnknownOutputExtensionFirst) {
   // the input does not even exist: the output extension is reported before any reading
   Outcome r = run({"mesh", path("missing.obj"), "-o", path("out.stl")});

@@ -288,7 +288,8 @@ class MeshTest(unittest.TestCase, HexMeshChecks):
         import inspect
         sig = inspect.signature(hexpeel.mesh)
         self.assertEqual(list(sig.parameters),
-                         ["points", "quads", "sharp_angle", "plan_budget", "threads"])
+                         ["points", "quads", "sharp_angle", "plan_budget", "threads",
+                          "repair_surface"])
         self.assertEqual(sig.parameters["sharp_angle"].default, 60.0)
         self.assertTrue(hexpeel.__doc__)
 
@@ -325,6 +326,16 @@ class ErrorTest(unittest.TestCase):
             e = self.assert_error("odd_quad_count", hexpeel.mesh, pts, quads)
         self.assertEqual(str(e), self.cli_error(pts, quads))
         self.assertIsInstance(e.report, dict)
+
+    def test_odd_quad_count_repaired(self):
+        pts, quads = prism_radial()
+        with self.assertWarnsRegex(UserWarning, "surface repaired"):
+            out_pts, hexes, report = hexpeel.mesh(pts, quads, repair_surface=True)
+        self.assertEqual(report["repair"]["input_quads"], 9)
+        self.assertTrue(report["repair"]["input_odd"])
+        self.assertEqual(report["scaled_jacobian"]["count_nonpositive"], 0)
+        self.assertEqual(len(hexes), report["hexes"])
+        np.testing.assert_array_equal(out_pts[: len(pts)], np.asarray(pts, dtype=float))
 
     def test_torus(self):
         pts, quads = torus()
