@@ -53,12 +53,16 @@ int main(int argc, char** argv) {
   CLI::App app{"Mesh every surface in a folder and tabulate the results"};
   std::string dir, reference, csv = "corpus.csv", md = "corpus.md", meshes;
   double time_limit = 120.0;
+  bool repair_surface = false;
   app.add_option("DIR", dir, "folder of surfaces (.obj .off .ply .mesh .msh .vtk)")->required();
   app.add_option("--reference", reference, "TSV: name, reference_hexes, reference_min_sj, reference_mean_sj");
   app.add_option("--csv", csv, "CSV output")->capture_default_str();
   app.add_option("--md", md, "markdown output")->capture_default_str();
   app.add_option("--meshes", meshes, "also write each hex mesh (.vtk) into this folder");
   app.add_option("--time-limit", time_limit, "elimination time limit per surface (s)")->capture_default_str();
+  app.add_flag("--repair-surface", repair_surface,
+               "mesh surfaces with self-crossing chords or odd counts refined (hexpeel mesh "
+               "--repair-surface); quads is then the refined count");
   CLI11_PARSE(app, argc, argv);
 
   std::vector<fs::path> files;
@@ -88,6 +92,7 @@ int main(int argc, char** argv) {
       if (!st.ok()) return nlohmann::json{{"status", std::string(to_string(st.code))}, {"message", st.message}};
       MeshParams p;
       p.elimination.time_limit_s = time_limit;
+      p.repair_surface = repair_surface;
       MeshResult m = run_mesh(soup, p);
       j = to_json(m);
       j["timings_s"]["read"] = read_s;

@@ -116,8 +116,28 @@ int cmd_check(const std::string& in, double sharp_angle, const std::string& json
   SurfaceDiagnosis d = diagnose_surface(soup, sharp_angle, make_context(nullptr, false));
   std::printf("%s", to_text(d).c_str());
   std::printf("path: %s\n", mesh_path(d).c_str());
+  nlohmann::json j = to_json(d);
+  if (d.status.code == StatusCode::self_intersecting_chord ||
+      d.status.code == StatusCode::odd_quad_count) {
+    // What `mesh --repair-surface` would do with it (an odd surface checked again, odd allowed).
+    ValidationParams odd_ok;
+    odd_ok.allow_odd = true;
+    const SurfaceDiagnosis e = d.status.code == StatusCode::odd_quad_count
+                                   ? diagnose_surface(soup, sharp_angle, Context{}, odd_ok)
+                                   : d;
+    if (e.validation.status.ok()) {
+      const SurfaceRepair rep = repair_surface(e.validation.surface);
+      if (rep.status.ok())
+        std::printf("with --repair-surface: refined into %d quads (%zu of %d split into six, the "
+                    "rest into four), every chord simple: `mesh --repair-surface` would mesh that\n",
+                    rep.stats.output_quads, rep.stats.six_split.size(), rep.stats.input_quads);
+      else
+        std::printf("with --repair-surface: %s\n", rep.status.message.c_str());
+      j["repair"] = to_json(rep.stats);
+    }
+  }
   if (!json_out.empty()) {
-    Status w = write_text_file(json_out, to_json(d).dump(2) + "\n");
+    Status w = write_text_file(json_out, j.dump(2) + "\n");
     if (!w.ok()) return report_error(w);
   }
   if (!d.status.ok()) {
