@@ -46,8 +46,9 @@ struct SurfaceRepair {
 QuadSurface refine_surface(const QuadSurface& surface, const std::vector<char>& six,
                            std::vector<int32_t>& parent);
 
-/// Repairs `surface` as described above. Deterministic.
-SurfaceRepair repair_surface(const QuadSurface& surface);
+/// Repairs `surface` as described above; with `six_everywhere`, every quad is split into six
+/// at once (all chords then go around the input vertices). Deterministic.
+SurfaceRepair repair_surface(const QuadSurface& surface, bool six_everywhere = false);
 
 nlohmann::json to_json(const SurfaceRepairStats& stats);
 

@@ -70,7 +70,7 @@ QuadSurface refine_surface(const QuadSurface& surface, const std::vector<char>& 
   return out;
 }
 
-SurfaceRepair repair_surface(const QuadSurface& surface) {
+SurfaceRepair repair_surface(const QuadSurface& surface, bool six_everywhere) {
   SurfaceRepair rep;
   SurfaceRepairStats& st = rep.stats;
   const int32_t n = surface.num_quads();
@@ -84,6 +84,7 @@ SurfaceRepair repair_surface(const QuadSurface& surface) {
       six[q] = 1;
       ++st.input_self_crossings;
     }
+  if (six_everywhere) std::fill(six.begin(), six.end(), 1);
   // vertex -> quads, for growing by vertex neighbours
   std::vector<std::vector<int32_t>> around(surface.num_points());
   for (int32_t q = 0; q < n; ++q)

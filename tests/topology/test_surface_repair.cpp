@@ -79,6 +79,13 @@ TEST(SurfaceRepair, SelfCrossingChordIsResolved) {
   EXPECT_EQ(stats_of(rep.surface).self_intersecting, 0);
   for (int32_t v = 0; v < in.num_points(); ++v) EXPECT_EQ(rep.surface.points[v], in.points[v]);
   expect_closed_manifold(rep.surface);
+  // split into six everywhere: the fallback the pipeline tries when the first does not mesh
+  const SurfaceRepair all = repair_surface(in, true);
+  ASSERT_TRUE(all.status.ok());
+  EXPECT_EQ(all.stats.six_split.size(), 8u);
+  EXPECT_EQ(all.surface.num_quads(), 48);
+  EXPECT_EQ(stats_of(all.surface).self_intersecting, 0);
+  EXPECT_EQ(stats_of(all.surface).count, in.num_points());  // one chord around each vertex
   // deterministic
   const SurfaceRepair again = repair_surface(in);
   EXPECT_EQ(again.surface.quads, rep.surface.quads);
