@@ -598,7 +598,7 @@ bool better_result(const MeshResult& a, const MeshResult& b) {
 /// when that mesh fails or keeps hexes with SJ <= 0, the surface split into six everywhere is
 /// meshed too and the better result kept (better_result).
 static MeshResult mesh_repaired(const SurfaceDiagnosis& diagnosis, const MeshParams& params,
-                         const Context& ctx, double check_s) {
+                                const Context& ctx, double check_s) {
   MeshParams inner = params;
   inner.repair_surface = false;
   inner.validation.allow_odd = false;
@@ -762,7 +762,7 @@ nlohmann::json to_json(const MeshResult& r) {
   j["status"] = std::string(to_string(r.status.code));
   j["message"] = r.status.message;
   j["input"] = to_json(r.diagnosis);
-  if (r.repair.applied || r.repair.input_quads > 0) j["repair"] = to_json(r.repair);
+  if (r.repair.input_quads > 0) j["repair"] = to_json(r.repair);  // the repair was tried
   const ChordStats& cs = r.diagnosis.chord_stats;
   j["chords"] = {{"count", cs.count},
                  {"min_length", cs.min_length},

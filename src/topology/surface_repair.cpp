@@ -98,9 +98,7 @@ SurfaceRepair repair_surface(const QuadSurface& surface, bool six_everywhere) {
     for (const Chord& c : chords.chords)
       for (int32_t q : c.crossings)
         if (!six[rep.parent[q]]) grow.push_back(rep.parent[q]);
-    bool any_crossing = false;
-    for (const Chord& c : chords.chords) any_crossing = any_crossing || c.self_intersecting;
-    if (!any_crossing) {
+    if (chord_stats(chords).self_intersecting == 0) {
       st.output_chords = static_cast<int32_t>(chords.chords.size());
       rep.surface = std::move(refined);
       break;
@@ -115,10 +113,12 @@ SurfaceRepair repair_surface(const QuadSurface& surface, bool six_everywhere) {
     if (grow.empty()) {
       for (const Chord& c : chords.chords)
         if (c.self_intersecting) {
-          rep.status = Status::error(StatusCode::self_intersecting_chord, "surface repair: with every quad split into six, a chord still "
-                               "crosses itself at refined quad " + std::to_string(c.crossings.front()) +
-                               " (in input quad " + std::to_string(rep.parent[c.crossings.front()]) +
-                               "); the surface cannot be repaired by refinement");
+          const int32_t at = c.crossings.front();
+          rep.status = Status::error(
+              StatusCode::self_intersecting_chord,
+              "surface repair: with every quad split into six, a chord still crosses itself at "
+              "refined quad " + std::to_string(at) + " (in input quad " +
+                  std::to_string(rep.parent[at]) + "); the surface cannot be repaired by refinement");
           break;
         }
       rep.parent.clear();
