@@ -22,6 +22,9 @@ int main(int argc, char** argv) {
   app.add_option("OUTDIR", outdir, "folder to write into (created)")->required();
   app.add_option("--family", family, "all | cubes | spheres | named | random | pillowed | perturbed")
       ->capture_default_str();
+  std::vector<int> sphere_n{4, 8, 12};
+  app.add_option("--sphere-n", sphere_n, "resolutions n of the cubed spheres (6 n^2 quads)")
+      ->check(CLI::Range(1, 512));
   CLI11_PARSE(app, argc, argv);
   std::filesystem::create_directories(outdir);
 
@@ -30,7 +33,7 @@ int main(int argc, char** argv) {
   if (want("cubes"))
     for (int n : {2, 4, 8}) out.push_back(ht::cube(n, n, n, 1.0 / n));
   if (want("spheres"))
-    for (int n : {4, 8, 12}) out.push_back(ht::cubed_sphere_equiangular(n));
+    for (int n : sphere_n) out.push_back(ht::cubed_sphere_equiangular(n));
   if (want("named"))
     for (const char* s : {"L", "Lblock", "U", "T", "pocket", "notch", "stairs", "steps"})
       for (int m = 1; m <= 3; ++m) out.push_back(ht::named_solid(s, m));

@@ -1,7 +1,9 @@
 // _hexpeel: the compiled part of the Python package `hexpeel` (python/hexpeel/__init__.py wraps
 // it). numpy arrays in and out; reports as Python dicts (the JSON of the CLI); every problem is a
 // hexpeel.Error (a ValueError) with the CLI's message and the status code's name as `code`.
+#include "hexpeel/chords.h"
 #include "hexpeel/diagnosis.h"
+#include "hexpeel/validation.h"
 #include "hexpeel/pipeline.h"
 #include "hexpeel/quality.h"
 #include "hexpeel/status.h"
@@ -238,6 +240,23 @@ py::object check(const py::object& points, const py::object& quads, double sharp
   return to_python(to_json(d));
 }
 
+py::array_t<int32_t> patches(const py::object& points, const py::object& quads, double sharp_angle) {
+  check_sharp_angle(sharp_angle);
+  PolygonSoup soup = read_soup(points, quads);
+  ValidationParams vp;
+  vp.allow_odd = true;  // patches need a closed oriented surface, not a meshable one
+  ValidationResult v = run_validation(soup, vp);
+  if (!v.status.ok()) fail(v.status);
+  const QuadSurface& s = v.surface;  // quads in input order (some reversed to agree)
+  const QuadAdjacency adj = build_adjacency(s);
+  int32_t count = 0;
+  const std::vector<int32_t> patch = sharp_patches(s, adj, classify_edges(s, adj, sharp_angle), count);
+  py::array_t<int32_t> out(static_cast<py::ssize_t>(patch.size()));
+  auto w = out.mutable_unchecked<1>();
+  for (size_t i = 0; i < patch.size(); ++i) w(i) = patch[i];
+  return out;
+}
+
 py::object quality(const py::object& points, const py::object& hexes) {
   HexMesh mesh;
   mesh.points = read_points(points);
@@ -314,6 +333,14 @@ PYBIND11_MODULE(_hexpeel, m) {
         "surface is not an error: d['status'] names the problem.\n"
         "Raises hexpeel.Error only for arrays that are not a surface at all (shape, dtype,\n"
         "ids out of range, no quads).");
+  m.def("patches", &patches, py::arg("points"), py::arg("quads"), py::kw_only(),
+        py::arg("sharp_angle") = 60.0,
+        "patches(points, quads, *, sharp_angle=60.0)\n--\n\n-> (M,) int32\n\n"
+        "The surface cut along its sharp edges (bent more than sharp_angle degrees from\n"
+        "flat) into patches, as a CAD part's faces: the 0-based patch of every quad, numbered\n"
+        "in the order of each patch's first quad (`hexpeel mesh --patch-sets`).\n"
+        "Raises hexpeel.Error for a surface `hexpeel check` refuses (open, non-manifold,\n"
+        "not a sphere, ...), an odd quad count aside.");
   m.def("quality", &quality, py::arg("points"), py::arg("hexes"),
         "quality(points, hexes)\n--\n\n-> dict\n\n"
         "Scaled Jacobian and topology of a hex mesh, as `hexpeel quality --json`.\n"

@@ -153,7 +153,7 @@ int cmd_check(const std::string& in, double sharp_angle, const std::string& json
 
 int cmd_mesh(const std::string& in, const std::string& out, const std::string& report,
              const std::string& dump_stuck, const std::string& repaired_out,
-             const MeshParams& params, bool quiet) {
+             const MeshParams& params, bool patch_sets, bool quiet) {
   if (!is_hex_mesh_extension(out))
     return report_error(Status::error(StatusCode::unsupported_format,
                                       "output '" + out + "': use .vtk, .vtu, .mesh, .msh, .inp, .exo or .e"));
@@ -163,6 +163,10 @@ int cmd_mesh(const std::string& in, const std::string& out, const std::string& r
   if (!repaired_out.empty() && !is_surface_extension(repaired_out))
     return report_error(Status::error(StatusCode::unsupported_format,
                                       "--repaired-surface '" + repaired_out + "': use .obj or .off"));
+  if (patch_sets && !carries_boundary_patches(out))
+    return report_error(Status::error(StatusCode::unsupported_format,
+                                      "--patch-sets: output '" + out + "' has no boundary groups; "
+                                      "use .exo, .e, .inp, .msh or .mesh"));
   if (!repaired_out.empty() && !params.repair_surface)
     return report_error(Status::error(StatusCode::unsupported_format,
                                       "--repaired-surface needs --repair-surface"));
@@ -182,7 +186,12 @@ int cmd_mesh(const std::string& in, const std::string& out, const std::string& r
   double write_s = 0.0;
   if (r.status.ok()) {
     t = Clock::now();
-    Status w = write_hex_mesh(out, r.mesh);
+    BoundaryPatches patches;
+    if (patch_sets) patches = boundary_patches(r, params.sharp_angle_deg);
+    Status w = write_hex_mesh(out, r.mesh, patch_sets ? &patches : nullptr);
+    if (w.ok() && patch_sets && !quiet)
+      std::printf("boundary patches: %d (cut along edges sharper than %g degrees), written as "
+                  "patch_1 .. patch_%d\n", patches.count, params.sharp_angle_deg, patches.count);
     if (w.ok() && !repaired_out.empty()) {
       // The mesh's boundary: the repaired surface, or the input itself when it needed none.
       w = write_surface(repaired_out, r.repair.applied ? r.repaired_surface
@@ -381,6 +390,11 @@ int main(int argc, char** argv) {
                  "is meshed; see docs/cli.md");
   mesh->add_option("--repaired-surface", repaired_out,
                    "with --repair-surface: also write the mesh's boundary surface (.obj .off)");
+  bool patch_sets = false;
+  mesh->add_flag("--patch-sets", patch_sets,
+                 "also write one boundary group per surface patch bounded by sharp edges "
+                 "(--sharp-angle), named patch_1.. (.exo .e .inp .msh .mesh; .vtk and .vtu have "
+                 "none)");
   mesh->add_option("--dump-stuck", dump_stuck, "when elimination gets stuck, write the surface it stopped at (.obj .off)");
   mesh->add_option("--sharp-angle", sharp_angle, "deviation from flat (degrees) above which an edge is sharp")
       ->check(CLI::Range(0.0, 180.0))->capture_default_str();
@@ -569,7 +583,7 @@ int main(int argc, char** argv) {
   mesh->set_help_all_flag("--help-all", "print every option, the expert ones too, and exit");
   for (CLI::Option* o : mesh->get_options()) {
     static const char* const kEveryday[] = {"help", "help-all", "output", "report", "dump-stuck",
-                                            "repair-surface", "repaired-surface",
+                                            "repair-surface", "repaired-surface", "patch-sets",
                                             "sharp-angle", "effort", "plan-budget", "pillow",
                                             "threads", "quiet"};
     const auto& lnames = o->get_lnames();
@@ -621,7 +635,7 @@ int main(int argc, char** argv) {
       params.reconstruction.fallback_to_extrusion = !strict_intrusion;
       params.intrusion_cover = !no_intrusion_cover;
       apply_effort(effort, *mesh, params);
-      return cmd_mesh(in, out, report, dump_stuck, repaired_out, params, quiet);
+      return cmd_mesh(in, out, report, dump_stuck, repaired_out, params, patch_sets, quiet);
     }
     if (*quality) return cmd_quality(in, surface, json_out);
   } catch (const std::bad_alloc&) {

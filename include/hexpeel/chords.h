@@ -57,4 +57,10 @@ struct EdgeGeometry {
 EdgeGeometry classify_edges(const QuadSurface& surface, const QuadAdjacency& adjacency,
                             double sharp_angle_deg = 60.0);
 
+/// The surface cut along its sharp edges (convex or concave in `edges`) into patches, as a CAD
+/// model's faces: patch[q] for every quad, numbered 0.. in the order of each patch's smallest
+/// quad id. Returns the patch count in `count`.
+std::vector<int32_t> sharp_patches(const QuadSurface& surface, const QuadAdjacency& adjacency,
+                                   const EdgeGeometry& edges, int32_t& count);
+
 }  // namespace hexpeel

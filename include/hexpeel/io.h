@@ -10,7 +10,8 @@
 // Hex meshes (write only, for FEA): .inp (Abaqus / CalculiX: C3D8 elements, node set BOUNDARY and
 //                              element-based surface BOUNDARY)  .exo .e (Exodus II: a HEX8 block,
 //                              node set and side set 1 "boundary"). The boundary groups hold every
-//                              hex face that occurs once in the mesh. See docs/formats.md.
+//                              hex face that occurs once in the mesh; BoundaryPatches add one
+//                              group per patch (also to .msh and .mesh). See docs/formats.md.
 //
 // Readers never crash on any bytes: every problem comes back as a Status naming the line (or
 // byte offset) and what was expected. Writers write to a temporary file beside the target and
@@ -40,8 +41,24 @@ Status write_surface(const std::filesystem::path& path, const QuadSurface& surfa
 /// otherwise they are an error. Hex corners come back in VTK order.
 Status read_hex_mesh(const std::filesystem::path& path, HexMesh& out, int64_t* others = nullptr);
 
+/// Named groups of a hex mesh's boundary faces: face i (mesh vertex ids, any corner order; a
+/// boundary face of the mesh) is in patch patch[i], 0 <= patch[i] < count.
+struct BoundaryPatches {
+  std::vector<Quad> faces;
+  std::vector<int32_t> patch;
+  int32_t count = 0;
+};
+
 /// Writes a hex mesh in the format its extension names, atomically, with full double precision.
-Status write_hex_mesh(const std::filesystem::path& path, const HexMesh& mesh);
+/// With `patches`, the formats that carry boundary groups get one per patch, named patch_1 ..
+/// patch_<count> (Exodus II side sets 2.., Abaqus surfaces PATCH_k, Gmsh physical surfaces of
+/// quads, MEDIT quadrilaterals with reference k); .vtk and .vtu carry none. A patch face that is
+/// not a boundary face of the mesh is an error.
+Status write_hex_mesh(const std::filesystem::path& path, const HexMesh& mesh,
+                      const BoundaryPatches* patches = nullptr);
+
+/// Whether the extension names a format write_hex_mesh writes boundary patches into.
+bool carries_boundary_patches(const std::filesystem::path& path);
 
 /// Writes `text` to `path` atomically (temporary file + rename). Used for reports too.
 Status write_text_file(const std::filesystem::path& path, const std::string& text);

@@ -8,6 +8,7 @@
 #include "hexpeel/planner.h"
 #include "hexpeel/embedding.h"
 #include "hexpeel/intrusion_cover.h"
+#include "hexpeel/io.h"
 #include "hexpeel/pillow.h"
 #include "hexpeel/quality.h"
 #include "hexpeel/reconstruction.h"
@@ -163,6 +164,12 @@ std::vector<OrderParams> alternative_orders(const OrderParams& base);
 bool better_result(const MeshResult& a, const MeshResult& b);
 
 MeshResult run_mesh(const PolygonSoup& soup, const MeshParams& params = {}, const Context& ctx = {});
+
+/// The mesh's boundary faces (the input surface's quads, or the repaired surface's when the
+/// repair was applied; mesh vertex ids) grouped into the patches sharp edges bound
+/// (sharp_patches, edges sharper than `sharp_angle_deg`), for write_hex_mesh's boundary sets.
+/// Empty (count 0) when r has no mesh.
+BoundaryPatches boundary_patches(const MeshResult& r, double sharp_angle_deg);
 
 /// The report: the quality JSON plus "status", "message", "input", "chords", "steps", "plan",
 /// "reconstruction", "pillow", "pillow_retry", "pillow_repair", "placement", "untangle", "timings_s", "method" {name, side_rule,

@@ -59,25 +59,25 @@ void append_elements(std::string& s, const HexMesh& mesh) {
   }
 }
 
-/// One element set _BOUNDARY_Sk per face number k that occurs, then the surface naming them.
-void append_surface(std::string& s, const std::vector<HexSide>& sides) {
+/// One element set _<NAME>_Sk per face number k that occurs, then the surface NAME naming them.
+void append_surface(std::string& s, const std::vector<HexSide>& sides, const std::string& name) {
   std::array<std::vector<int32_t>, 6> by_face;
   for (const HexSide& side : sides) by_face[side.side].push_back(side.hex);
   for (size_t k = 0; k < 6; ++k) {
     if (by_face[k].empty()) continue;
-    s += "*ELSET, ELSET=_BOUNDARY_S" + std::to_string(k + 1) + "\n";
+    s += "*ELSET, ELSET=_" + name + "_S" + std::to_string(k + 1) + "\n";
     append_id_lines(s, by_face[k]);
   }
-  s += "*SURFACE, NAME=BOUNDARY, TYPE=ELEMENT\n";
+  s += "*SURFACE, NAME=" + name + ", TYPE=ELEMENT\n";
   for (size_t k = 0; k < 6; ++k) {
     if (by_face[k].empty()) continue;
-    s += "_BOUNDARY_S" + std::to_string(k + 1) + ", S" + std::to_string(k + 1) + "\n";
+    s += "_" + name + "_S" + std::to_string(k + 1) + ", S" + std::to_string(k + 1) + "\n";
   }
 }
 
 }  // namespace
 
-std::string write_abaqus(const HexMesh& mesh) {
+std::string write_abaqus(const HexMesh& mesh, const PatchLookup* patches) {
   std::string s = "*HEADING\nhexpeel hex mesh: ";
   append_int(s, mesh.num_points());
   s += " nodes, ";
@@ -89,7 +89,12 @@ std::string write_abaqus(const HexMesh& mesh) {
   if (!sides.empty()) {
     s += "*NSET, NSET=BOUNDARY\n";
     append_id_lines(s, side_vertices(mesh, kC3D8Faces, sides));
-    append_surface(s, sides);
+    append_surface(s, sides, "BOUNDARY");
+    if (patches != nullptr) {
+      const std::vector<std::vector<HexSide>> parts = patches->by_patch(mesh, kC3D8Faces, sides);
+      for (size_t k = 0; k < parts.size(); ++k)
+        if (!parts[k].empty()) append_surface(s, parts[k], "PATCH_" + std::to_string(k + 1));
+    }
   }
   return s;
 }

@@ -127,17 +127,31 @@ Status put_mesh(const std::filesystem::path& path, int id, const HexMesh& mesh) 
   return Status::success();
 }
 
-/// Set kSetId of `type` named "boundary": `entries` (1-based) and, for a side set, `extra` (the
+/// Set `set_id` of `type` named `name`: `entries` (1-based) and, for a side set, `extra` (the
 /// side numbers).
 Status put_set(const std::filesystem::path& path, int id, ex_entity_type type,
-               const std::vector<int>& entries, const std::vector<int>* extra) {
+               const std::vector<int>& entries, const std::vector<int>* extra,
+               int64_t set_id = kSetId, const char* name = "boundary") {
   const int64_t n = static_cast<int64_t>(entries.size());
-  if (ex_put_set_param(id, type, kSetId, n, 0) < 0) return library_error(path, "ex_put_set_param");
-  if (ex_put_set(id, type, kSetId, entries.data(), extra != nullptr ? extra->data() : nullptr) < 0) {
+  if (ex_put_set_param(id, type, set_id, n, 0) < 0) return library_error(path, "ex_put_set_param");
+  if (ex_put_set(id, type, set_id, entries.data(), extra != nullptr ? extra->data() : nullptr) < 0) {
     return library_error(path, "ex_put_set");
   }
-  if (ex_put_name(id, type, kSetId, "boundary") < 0) return library_error(path, "ex_put_name");
+  if (ex_put_name(id, type, set_id, name) < 0) return library_error(path, "ex_put_name");
   return Status::success();
+}
+
+/// Side set `set_id` named `name` of `sides`.
+Status put_side_set(const std::filesystem::path& path, int id, const std::vector<HexSide>& sides,
+                    int64_t set_id, const std::string& name) {
+  std::vector<int> elements, numbers;
+  elements.reserve(sides.size());
+  numbers.reserve(sides.size());
+  for (const HexSide& side : sides) {
+    elements.push_back(side.hex + 1);
+    numbers.push_back(side.side + 1);
+  }
+  return put_set(path, id, EX_SIDE_SET, elements, &numbers, set_id, name.c_str());
 }
 
 Status put_boundary(const std::filesystem::path& path, int id, const HexMesh& mesh,
@@ -148,19 +162,12 @@ Status put_boundary(const std::filesystem::path& path, int id, const HexMesh& me
       !s.ok()) {
     return s;
   }
-  std::vector<int> elements, numbers;
-  elements.reserve(sides.size());
-  numbers.reserve(sides.size());
-  for (const HexSide& side : sides) {
-    elements.push_back(side.hex + 1);
-    numbers.push_back(side.side + 1);
-  }
-  return put_set(path, id, EX_SIDE_SET, elements, &numbers);
+  return put_side_set(path, id, sides, kSetId, "boundary");
 }
 
 }  // namespace
 
-Status write_exodus(const std::filesystem::path& path, const HexMesh& mesh) {
+Status write_exodus(const std::filesystem::path& path, const HexMesh& mesh, const PatchLookup* patches) {
   if (path.filename().empty()) {
     return Status::error(StatusCode::io_error, path.string() + ": not a file name");
   }
@@ -170,12 +177,23 @@ Status write_exodus(const std::filesystem::path& path, const HexMesh& mesh) {
   if (Status s = create_temporary(path, file); !s.ok()) return s;
   const int64_t blocks = mesh.hexes.empty() ? 0 : 1;
   const int64_t sets = sides.empty() ? 0 : 1;
+  // Side sets 2.. for the patches that hold sides (ids in patch order).
+  std::vector<std::vector<HexSide>> parts;
+  if (patches != nullptr && !sides.empty()) parts = patches->by_patch(mesh, kHex8Sides, sides);
+  int64_t side_sets = sets;
+  for (const auto& part : parts) side_sets += part.empty() ? 0 : 1;
   if (ex_put_init(file.id, "hexpeel hex mesh", 3, mesh.num_points(), mesh.num_hexes(), blocks, sets,
-                  sets) < 0) {
+                  side_sets) < 0) {
     return library_error(path, "ex_put_init");
   }
   if (Status s = put_mesh(path, file.id, mesh); !s.ok()) return s;
   if (Status s = put_boundary(path, file.id, mesh, sides); !s.ok()) return s;
+  for (size_t k = 0; k < parts.size(); ++k) {
+    if (parts[k].empty()) continue;
+    const std::string name = "patch_" + std::to_string(k + 1);
+    if (Status s = put_side_set(path, file.id, parts[k], static_cast<int64_t>(k) + 2, name); !s.ok())
+      return s;
+  }
   const int closed = ex_close(file.id);
   file.id = -1;
   if (closed < 0) return library_error(path, "ex_close");

@@ -7,6 +7,7 @@
 #pragma once
 
 #include "hexpeel/hex_mesh.h"
+#include "io/hex_sides.h"
 #include "io/io_util.h"
 
 #include <filesystem>
@@ -25,13 +26,19 @@ Status read_vtu(std::string_view data, const std::string& name, CellSoup& out);
 
 std::string write_obj(const QuadSurface& surface);
 std::string write_off(const QuadSurface& surface);
-std::string write_vtk_legacy(const HexMesh& mesh);
-std::string write_vtu(const HexMesh& mesh);
-std::string write_medit(const HexMesh& mesh);
-std::string write_gmsh(const HexMesh& mesh);
-/// Abaqus / CalculiX .inp: C3D8 elements (ELSET HEXES), NSET BOUNDARY, SURFACE BOUNDARY.
-std::string write_abaqus(const HexMesh& mesh);
-/// Exodus II: writes `path` (temporary file + rename); library errors name `path`.
-Status write_exodus(const std::filesystem::path& path, const HexMesh& mesh);
+// `patches` (checked, may be null): the boundary groups, for the formats that carry them.
+std::string write_vtk_legacy(const HexMesh& mesh, const PatchLookup* patches);
+std::string write_vtu(const HexMesh& mesh, const PatchLookup* patches);
+/// MEDIT: with patches, Quadrilaterals (the patch faces, reference = patch + 1).
+std::string write_medit(const HexMesh& mesh, const PatchLookup* patches);
+/// Gmsh 4.1: with patches, one surface entity of quads per patch, physical groups patch_k (2D)
+/// and hexes (3D).
+std::string write_gmsh(const HexMesh& mesh, const PatchLookup* patches);
+/// Abaqus / CalculiX .inp: C3D8 elements (ELSET HEXES), NSET BOUNDARY, SURFACE BOUNDARY; with
+/// patches also SURFACE PATCH_k.
+std::string write_abaqus(const HexMesh& mesh, const PatchLookup* patches);
+/// Exodus II: writes `path` (temporary file + rename); library errors name `path`. With
+/// patches, side sets 2.. named patch_k after side set 1 "boundary".
+Status write_exodus(const std::filesystem::path& path, const HexMesh& mesh, const PatchLookup* patches);
 
 }  // namespace hexpeel::io

@@ -350,22 +350,67 @@ Status read_gmsh(std::string_view data, const std::string& name, CellSoup& out) 
   return Status::success();
 }
 
-std::string write_gmsh(const HexMesh& mesh) {
+namespace {
+
+/// " minX minY minZ maxX maxY maxZ" of `points` (zeros for none).
+void append_box(std::string& s, const std::vector<Vec3>& points, const std::vector<int32_t>* ids) {
   Vec3 lo = Vec3::Zero(), hi = Vec3::Zero();
-  if (!mesh.points.empty()) {
-    lo = hi = mesh.points.front();
-    for (const Vec3& p : mesh.points) {
-      lo = lo.cwiseMin(p);
-      hi = hi.cwiseMax(p);
-    }
-  }
-  const int64_t np = mesh.num_points(), nh = mesh.num_hexes();
-  std::string s = "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n";
-  // One volume entity holding everything, so Gmsh itself can load the file.
-  s += "$Entities\n0 0 0 1\n1";
+  bool first = true;
+  auto add = [&](const Vec3& p) {
+    if (first) lo = hi = p, first = false;
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  };
+  if (ids != nullptr)
+    for (const int32_t v : *ids) add(points[v]);
+  else
+    for (const Vec3& p : points) add(p);
   for (int k = 0; k < 3; ++k) (s += ' ', append_real(s, lo[k]));
   for (int k = 0; k < 3; ++k) (s += ' ', append_real(s, hi[k]));
-  s += " 0 0\n$EndEntities\n$Nodes\n1 ";
+}
+
+}  // namespace
+
+std::string write_gmsh(const HexMesh& mesh, const PatchLookup* patches) {
+  const int64_t np = mesh.num_points(), nh = mesh.num_hexes();
+  const BoundaryPatches* bp = patches != nullptr ? patches->patches : nullptr;
+  const int32_t npatch = bp != nullptr ? bp->count : 0;
+  // The faces of each patch, in the order given, and their vertices (for the entity boxes).
+  std::vector<std::vector<int32_t>> faces_of(npatch), verts_of(npatch);
+  if (bp != nullptr)
+    for (size_t i = 0; i < bp->faces.size(); ++i) {
+      faces_of[bp->patch[i]].push_back(static_cast<int32_t>(i));
+      for (const int32_t v : bp->faces[i]) verts_of[bp->patch[i]].push_back(v);
+    }
+  std::string s = "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n";
+  if (bp != nullptr) {
+    s += "$PhysicalNames\n";
+    append_int(s, int64_t{npatch} + 1);
+    s += '\n';
+    for (int32_t k = 1; k <= npatch; ++k) s += "2 " + std::to_string(k) + " \"patch_" + std::to_string(k) + "\"\n";
+    s += "3 1 \"hexes\"\n$EndPhysicalNames\n";
+  }
+  // One volume entity holding every node and hex, so Gmsh itself can load the file; with
+  // patches, one surface entity per patch (physical group k) bounding it.
+  s += "$Entities\n0 0 ";
+  append_int(s, npatch);
+  s += " 1\n";
+  for (int32_t k = 1; k <= npatch; ++k) {
+    append_int(s, k);
+    append_box(s, mesh.points, &verts_of[k - 1]);
+    s += " 1 " + std::to_string(k) + " 0\n";
+  }
+  s += '1';
+  append_box(s, mesh.points, nullptr);
+  if (bp == nullptr) {
+    s += " 0 0\n";
+  } else {
+    s += " 1 1 ";
+    append_int(s, npatch);
+    for (int32_t k = 1; k <= npatch; ++k) s += ' ' + std::to_string(k);
+    s += '\n';
+  }
+  s += "$EndEntities\n$Nodes\n1 ";
   append_int(s, np);
   s += np > 0 ? " 1 " : " 0 ";
   append_int(s, np);
@@ -377,10 +422,13 @@ std::string write_gmsh(const HexMesh& mesh) {
     append_point(s, p);
     s += '\n';
   }
-  s += "$EndNodes\n$Elements\n1 ";
-  append_int(s, nh);
-  s += nh > 0 ? " 1 " : " 0 ";
-  append_int(s, nh);
+  const int64_t nf = bp != nullptr ? static_cast<int64_t>(bp->faces.size()) : 0;
+  s += "$EndNodes\n$Elements\n";
+  append_int(s, 1 + int64_t{npatch});
+  s += ' ';
+  append_int(s, nh + nf);
+  s += nh + nf > 0 ? " 1 " : " 0 ";
+  append_int(s, nh + nf);
   s += "\n3 1 5 ";
   append_int(s, nh);
   s += '\n';
@@ -388,6 +436,17 @@ std::string write_gmsh(const HexMesh& mesh) {
     append_int(s, h + 1);
     for (int32_t v : mesh.hexes[h]) (s += ' ', append_int(s, int64_t{v} + 1));
     s += '\n';
+  }
+  int64_t tag = nh;
+  for (int32_t k = 1; k <= npatch; ++k) {
+    s += "2 " + std::to_string(k) + " 3 ";
+    append_int(s, static_cast<int64_t>(faces_of[k - 1].size()));
+    s += '\n';
+    for (const int32_t i : faces_of[k - 1]) {
+      append_int(s, ++tag);
+      for (int32_t v : bp->faces[i]) (s += ' ', append_int(s, int64_t{v} + 1));
+      s += '\n';
+    }
   }
   s += "$EndElements\n";
   return s;

@@ -18,7 +18,7 @@ using io::CellKind;
 using io::CellSoup;
 
 using Reader = Status (*)(std::string_view, const std::string&, CellSoup&);
-using HexWriter = std::string (*)(const HexMesh&);
+using HexWriter = std::string (*)(const HexMesh&, const io::PatchLookup*);
 
 std::string lower_extension(const std::filesystem::path& path) {
   std::string ext = path.extension().string();
@@ -200,11 +200,24 @@ Status write_surface(const std::filesystem::path& path, const QuadSurface& surfa
   return unsupported(path, "surface output", ".obj .off");
 }
 
-Status write_hex_mesh(const std::filesystem::path& path, const HexMesh& mesh) {
+Status write_hex_mesh(const std::filesystem::path& path, const HexMesh& mesh,
+                      const BoundaryPatches* patches) {
   const std::string ext = lower_extension(path);
-  if (const HexWriter writer = hex_text_writer(ext)) return io::write_file_atomic(path, writer(mesh));
-  if (is_exodus_extension(ext)) return io::write_exodus(path, mesh);
-  return unsupported(path, "hex mesh output", kHexOutputExtensions);
+  const HexWriter writer = hex_text_writer(ext);
+  if (writer == nullptr && !is_exodus_extension(ext))
+    return unsupported(path, "hex mesh output", kHexOutputExtensions);
+  io::PatchLookup lookup;
+  if (patches != nullptr)
+    if (Status s = io::make_patch_lookup(mesh, *patches, lookup); !s.ok())
+      return Status::error(s.code, path.string() + ": " + s.message);
+  const io::PatchLookup* p = patches != nullptr ? &lookup : nullptr;
+  if (writer != nullptr) return io::write_file_atomic(path, writer(mesh, p));
+  return io::write_exodus(path, mesh, p);
+}
+
+bool carries_boundary_patches(const std::filesystem::path& path) {
+  const std::string ext = lower_extension(path);
+  return ext == ".mesh" || ext == ".msh" || ext == ".inp" || is_exodus_extension(ext);
 }
 
 Status write_text_file(const std::filesystem::path& path, const std::string& text) {

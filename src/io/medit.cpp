@@ -110,7 +110,7 @@ Status read_medit(std::string_view data, const std::string& name, CellSoup& out)
   return Status::success();
 }
 
-std::string write_medit(const HexMesh& mesh) {
+std::string write_medit(const HexMesh& mesh, const PatchLookup* patches) {
   std::string s = "MeshVersionFormatted 2\nDimension 3\n\nVertices\n";
   append_int(s, mesh.num_points());
   s += '\n';
@@ -127,6 +127,20 @@ std::string write_medit(const HexMesh& mesh) {
       s += ' ';
     }
     s += "0\n";
+  }
+  if (patches != nullptr) {
+    const BoundaryPatches& bp = *patches->patches;
+    s += "\nQuadrilaterals\n";
+    append_int(s, static_cast<int64_t>(bp.faces.size()));
+    s += '\n';
+    for (size_t i = 0; i < bp.faces.size(); ++i) {
+      for (int32_t v : bp.faces[i]) {
+        append_int(s, int64_t{v} + 1);
+        s += ' ';
+      }
+      append_int(s, int64_t{bp.patch[i]} + 1);
+      s += '\n';
+    }
   }
   s += "\nEnd\n";
   return s;

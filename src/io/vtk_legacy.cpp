@@ -241,7 +241,7 @@ Status read_vtk_legacy(std::string_view data, const std::string& name, CellSoup&
   return Status::success();
 }
 
-std::string write_vtk_legacy(const HexMesh& mesh) {
+std::string write_vtk_legacy(const HexMesh& mesh, const PatchLookup* /*patches: none in VTK*/) {
   const int64_t np = mesh.num_points(), nh = mesh.num_hexes();
   std::string s = "# vtk DataFile Version 4.2\nhex mesh written by hexpeel\nASCII\n"
                   "DATASET UNSTRUCTURED_GRID\nPOINTS ";

@@ -389,7 +389,7 @@ Status read_vtu(std::string_view data, const std::string& name, CellSoup& out) {
   return Status::success();
 }
 
-std::string write_vtu(const HexMesh& mesh) {
+std::string write_vtu(const HexMesh& mesh, const PatchLookup* /*patches: none in VTK*/) {
   const int64_t np = mesh.num_points(), nh = mesh.num_hexes();
   std::string s =
       "<?xml version=\"1.0\"?>\n"

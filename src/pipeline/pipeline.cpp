@@ -647,6 +647,16 @@ static MeshResult mesh_repaired(const SurfaceDiagnosis& diagnosis, const MeshPar
   return best;
 }
 
+BoundaryPatches boundary_patches(const MeshResult& r, double sharp_angle_deg) {
+  BoundaryPatches out;
+  if (!r.status.ok()) return out;
+  const QuadSurface& s = r.repair.applied ? r.repaired_surface : r.diagnosis.validation.surface;
+  const QuadAdjacency adj = build_adjacency(s);
+  out.patch = sharp_patches(s, adj, classify_edges(s, adj, sharp_angle_deg), out.count);
+  out.faces = s.quads;
+  return out;
+}
+
 MeshResult run_mesh(const PolygonSoup& soup, const MeshParams& params, const Context& ctx) {
   // Far from unit size, the whole run works on the soup scaled by a power of two (exact), and
   // what it returns is scaled back: the boundary vertices come back exactly as read.

@@ -57,4 +57,30 @@ EdgeGeometry classify_edges(const QuadSurface& surface, const QuadAdjacency& adj
   return g;
 }
 
+std::vector<int32_t> sharp_patches(const QuadSurface& surface, const QuadAdjacency& adjacency,
+                                   const EdgeGeometry& edges, int32_t& count) {
+  const int32_t nq = surface.num_quads();
+  std::vector<int32_t> patch(nq, -1);
+  count = 0;
+  std::vector<int32_t> stack;
+  for (int32_t q0 = 0; q0 < nq; ++q0) {
+    if (patch[q0] >= 0) continue;
+    patch[q0] = count;
+    stack.assign(1, q0);
+    while (!stack.empty()) {
+      const int32_t q = stack.back();
+      stack.pop_back();
+      for (int k = 0; k < 4; ++k) {
+        const int32_t he = 4 * q + k;
+        const int32_t o = adjacency.opposite[he];
+        if (o < 0 || edges.kind[he] != EdgeKind::flat || patch[o >> 2] >= 0) continue;
+        patch[o >> 2] = count;
+        stack.push_back(o >> 2);
+      }
+    }
+    ++count;
+  }
+  return patch;
+}
+
 }  // namespace hexpeel

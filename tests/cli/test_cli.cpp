@@ -858,6 +858,27 @@ TEST_F(Cli, RepairSurfaceMeshesRefusedSurfacesAndWritesTheBoundary) {
   EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
 }
 
+TEST_F(Cli, PatchSetsNameTheSidesOfABox) {
+  const std::string in = write("cube3.obj", gen::cube(3, 3, 3, 1.0 / 3).surface);
+  // a format without boundary groups: a usage error naming the option, nothing written
+  Outcome r = run({"mesh", in, "-o", path("out.vtk"), "--patch-sets"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_TRUE(contains(r.err, "--patch-sets")) << r.err;
+  EXPECT_EQ(listing(), std::vector<std::string>{"cube3.obj"});
+  r = run({"mesh", in, "-o", path("out.inp"), "--patch-sets"});
+  EXPECT_NO_SIGNAL(r);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(contains(r.out, "boundary patches: 6")) << r.out;
+  const std::string deck = slurp(path("out.inp"));
+  EXPECT_TRUE(contains(deck, "*SURFACE, NAME=BOUNDARY, TYPE=ELEMENT")) << deck.substr(0, 200);
+  EXPECT_TRUE(contains(deck, "*SURFACE, NAME=PATCH_6, TYPE=ELEMENT"));
+  EXPECT_FALSE(contains(deck, "PATCH_7"));
+  // every quad of one side in one patch: 9 faces each, over the six patches' element sets
+  r = run({"mesh", in, "-o", path("plain.inp")});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_FALSE(contains(slurp(path("plain.inp")), "PATCH_"));
+}
+
 TEST_F(Cli, MeshRejectsUnknownOutputExtensionFirst) {
   // the input does not even exist: the output extension is reported before any reading
   Outcome r = run({"mesh", path("missing.obj"), "-o", path("out.stl")});

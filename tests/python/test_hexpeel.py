@@ -280,7 +280,7 @@ class MeshTest(unittest.TestCase, HexMeshChecks):
         self.assertGreater(len(during), 1000)
 
     def test_docstrings(self):
-        for f in (hexpeel.mesh, hexpeel.check, hexpeel.quality, hexpeel.mesh_meshio):
+        for f in (hexpeel.mesh, hexpeel.check, hexpeel.quality, hexpeel.patches, hexpeel.mesh_meshio):
             self.assertTrue(f.__doc__ and len(f.__doc__) > 80, f)
         self.assertIn("sharp_angle", hexpeel.mesh.__doc__)
         self.assertIn("VTK", hexpeel.mesh.__doc__)
@@ -459,6 +459,47 @@ class MeshioTest(unittest.TestCase, HexMeshChecks):
         self.assertEqual(out.hexpeel_report["hexes"], len(ref[1]))
         self.assert_valid_mesh(pts, quads, np.asarray(out.points), out.cells[0].data,
                                out.hexpeel_report)
+
+    def test_patches_of_a_box(self):
+        pts, quads = grid_box(2)
+        patch = hexpeel.patches(pts, quads)
+        self.assertEqual(patch.shape, (len(quads),))
+        self.assertEqual(sorted(set(patch.tolist())), list(range(6)))
+        # the same patch exactly when the quads face the same way (outward normal)
+        normal = [tuple(np.sign(np.round(np.cross(pts[q[1]] - pts[q[0]], pts[q[3]] - pts[q[0]]))))
+                  for q in quads]
+        for i in range(len(quads)):
+            for j in range(len(quads)):
+                self.assertEqual(patch[i] == patch[j], normal[i] == normal[j], (i, j))
+        # bends below the threshold do not cut: one patch at 100 degrees
+        self.assertEqual(set(hexpeel.patches(pts, quads, sharp_angle=100.0).tolist()), {0})
+        rp, rq = prism_radial()  # an odd count is no obstacle to patches
+        self.assertEqual(len(hexpeel.patches(rp, rq)), len(rq))
+        for (p, q), code in (((pts, quads[:-1]), "open_boundary"), (torus(), "nonzero_genus")):
+            with self.assertRaises(hexpeel.Error) as cm:
+                hexpeel.patches(p, q)
+            self.assertEqual(cm.exception.code, code)
+
+    def test_mesh_meshio_patch_sets(self):
+        import meshio
+        pts, quads = grid_box(2)
+        out = hexpeel.mesh_meshio(meshio.Mesh(pts, [("quad", quads)]), patch_sets=True, threads=1)
+        self.assertEqual([c.type for c in out.cells], ["hexahedron", "quad"])
+        np.testing.assert_array_equal(out.cells[1].data, quads)
+        self.assertEqual(sorted(out.cell_sets), ["patch_%d" % k for k in range(1, 7)])
+        got = sorted(int(i) for k in out.cell_sets for i in out.cell_sets[k][1])
+        self.assertEqual(got, list(range(len(quads))))  # every quad in exactly one patch
+        for k in out.cell_sets:
+            self.assertEqual(len(out.cell_sets[k][0]), 0)
+            self.assertEqual(len(out.cell_sets[k][1]), 4)  # a 2 x 2 side
+        # repaired: the boundary is the refined surface, found from the hexes
+        rp, rq = prism_radial()
+        with self.assertWarnsRegex(UserWarning, "surface repaired"):
+            rep = hexpeel.mesh_meshio(meshio.Mesh(rp, [("quad", rq)]), patch_sets=True,
+                                      repair_surface=True)
+        bq = rep.cells[1].data
+        self.assertEqual(len(bq), rep.hexpeel_report["repair"]["output_quads"])
+        self.assertEqual(sum(len(v[1]) for v in rep.cell_sets.values()), len(bq))
 
     def test_mesh_meshio_errors(self):
         import meshio
