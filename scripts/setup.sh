@@ -12,6 +12,7 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-numpy python3-vtk9 python3-meshio python3-netcdf4
   pybind11-dev python3-dev
+  chromium  # only for the test of the HTML report (headless)
 )
 
 if [[ "${1:-}" != "--no-install" ]]; then
@@ -29,5 +30,5 @@ site=$(/usr/bin/python3 -m site --user-site)
 mkdir -p "$site" && echo "$PWD/build/python" > "$site/hexpeel.pth"
 
 mkdir -p out
-./build/hexpeel mesh examples/stairs.obj -o out/stairs.vtk --report out/stairs.json
-echo "wrote out/stairs.vtk (hex mesh) and out/stairs.json (quality report)"
+./build/hexpeel mesh examples/stairs.obj -o out/stairs.vtk --report out/stairs.json --html out/stairs.html
+echo "wrote out/stairs.vtk (hex mesh), out/stairs.json and out/stairs.html (quality report)"

@@ -20,6 +20,7 @@
 // 4 internal error (a bug: please report it with the input), 5 (`mesh`) the mesh was written but
 // has hexes with scaled Jacobian <= 0 (a warning on stderr says how many).
 #include "hexpeel/diagnosis.h"
+#include "hexpeel/html_report.h"
 #include "hexpeel/io.h"
 #include "hexpeel/pipeline.h"
 #include "hexpeel/quality.h"
@@ -153,7 +154,7 @@ int cmd_check(const std::string& in, double sharp_angle, const std::string& json
 
 int cmd_mesh(const std::string& in, const std::string& out, const std::string& report,
              const std::string& dump_stuck, const std::string& repaired_out,
-             const MeshParams& params, bool patch_sets, bool quiet) {
+             const std::string& html_out, const MeshParams& params, bool patch_sets, bool quiet) {
   if (!is_hex_mesh_extension(out))
     return report_error(Status::error(StatusCode::unsupported_format,
                                       "output '" + out + "': use .vtk, .vtu, .mesh, .msh, .inp, .exo or .e"));
@@ -197,6 +198,15 @@ int cmd_mesh(const std::string& in, const std::string& out, const std::string& r
       w = write_surface(repaired_out, r.repair.applied ? r.repaired_surface
                                                        : r.diagnosis.validation.surface);
       if (!w.ok()) std::filesystem::remove(out);
+    }
+    if (w.ok() && !html_out.empty()) {
+      HtmlReportParams hp;
+      hp.title = std::filesystem::path(in).filename().string();
+      w = write_text_file(html_out, html_report(r.mesh, r.quality, hp));
+      if (!w.ok()) {
+        std::filesystem::remove(out);
+        if (!repaired_out.empty()) std::filesystem::remove(repaired_out);
+      }
     }
     write_s = seconds_since(t);
     if (!w.ok()) r.status = w;
@@ -300,7 +310,7 @@ int cmd_mesh(const std::string& in, const std::string& out, const std::string& r
 }
 
 int cmd_quality(const std::string& mesh_path, const std::string& surface_path,
-                const std::string& json_out) {
+                const std::string& json_out, const std::string& html_out) {
   HexMesh mesh;
   int64_t others = 0;
   Status st = read_hex_mesh(mesh_path, mesh, &others);
@@ -323,6 +333,12 @@ int cmd_quality(const std::string& mesh_path, const std::string& surface_path,
   std::printf("%s", to_text(q).c_str());
   if (!json_out.empty()) {
     Status w = write_text_file(json_out, to_json(q).dump(2) + "\n");
+    if (!w.ok()) return report_error(w);
+  }
+  if (!html_out.empty()) {
+    HtmlReportParams hp;
+    hp.title = std::filesystem::path(mesh_path).filename().string();
+    Status w = write_text_file(html_out, html_report(mesh, q, hp));
     if (!w.ok()) return report_error(w);
   }
   // A mesh that fails the check is bad input (exit 2; 1 is kept for usage errors).
@@ -368,7 +384,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "hexpeel 0.1.0");
   app.require_subcommand(1);
 
-  std::string in, out, report, dump_stuck, json_out, surface, repaired_out;
+  std::string in, out, report, dump_stuck, json_out, surface, repaired_out, html_out;
   double sharp_angle = 60.0;
   bool quiet = false;
   MeshParams params;
@@ -384,6 +400,9 @@ int main(int argc, char** argv) {
   mesh->add_option("IN", in, "surface file (.obj .off .ply .mesh .msh .vtk)")->required();
   mesh->add_option("-o,--output", out, "hex mesh to write (.vtk .vtu .mesh .msh .inp .exo .e)")->required();
   mesh->add_option("--report", report, "write a JSON report: quality, chords, steps, status, timings");
+  mesh->add_option("--html", html_out,
+                   "also write an HTML quality report: figures, histogram, worst hexes, 3D view "
+                   "with a cutaway plane (self-contained; open it in a browser)");
   mesh->add_flag("--repair-surface", params.repair_surface,
                  "a surface with a self-crossing chord or an odd quad count is refined into one "
                  "hexpeel can mesh (input vertices kept, every quad split into 4 or 6) and that "
@@ -582,7 +601,7 @@ int main(int argc, char** argv) {
   });
   mesh->set_help_all_flag("--help-all", "print every option, the expert ones too, and exit");
   for (CLI::Option* o : mesh->get_options()) {
-    static const char* const kEveryday[] = {"help", "help-all", "output", "report", "dump-stuck",
+    static const char* const kEveryday[] = {"help", "help-all", "output", "report", "html", "dump-stuck",
                                             "repair-surface", "repaired-surface", "patch-sets",
                                             "sharp-angle", "effort", "plan-budget", "pillow",
                                             "threads", "quiet"};
@@ -597,6 +616,7 @@ int main(int argc, char** argv) {
   quality->add_option("MESH", in, "hex mesh file")->required();
   quality->add_option("--surface", surface, "also check that the mesh boundary equals this surface");
   quality->add_option("--json", json_out, "also write the report as JSON");
+  quality->add_option("--html", html_out, "also write an HTML report: figures, histogram, worst hexes, 3D view");
   quality->add_option("--threads", threads, threads_help)->check(CLI::Range(0, 1024))->capture_default_str();
 
   try {
@@ -635,9 +655,9 @@ int main(int argc, char** argv) {
       params.reconstruction.fallback_to_extrusion = !strict_intrusion;
       params.intrusion_cover = !no_intrusion_cover;
       apply_effort(effort, *mesh, params);
-      return cmd_mesh(in, out, report, dump_stuck, repaired_out, params, patch_sets, quiet);
+      return cmd_mesh(in, out, report, dump_stuck, repaired_out, html_out, params, patch_sets, quiet);
     }
-    if (*quality) return cmd_quality(in, surface, json_out);
+    if (*quality) return cmd_quality(in, surface, json_out, html_out);
   } catch (const std::bad_alloc&) {
     std::fprintf(stderr, "hexpeel: error: out of memory\n");
     return 4;

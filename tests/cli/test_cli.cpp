@@ -879,6 +879,66 @@ TEST_F(Cli, PatchSetsNameTheSidesOfABox) {
   EXPECT_FALSE(contains(slurp(path("plain.inp")), "PATCH_"));
 }
 
+TEST_F(Cli, HtmlReportLoadsInHeadlessChromium) {
+  const std::string in = write("L.obj", gen::named_solid("L", 2).surface);
+  Outcome r = run({"mesh", in, "-o", path("m.vtk"), "--html", path("m.html"), "-q"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string page = slurp(path("m.html"));
+  // self-contained: nothing fetched from anywhere
+  EXPECT_FALSE(contains(page, "http://"));
+  EXPECT_FALSE(contains(page, "https://"));
+  EXPECT_FALSE(contains(page, " src=")) << "an external script or image";
+  EXPECT_TRUE(contains(page, "<svg class=\"hist\""));
+  EXPECT_TRUE(contains(page, "<h1>L.obj</h1>"));
+  // hexpeel quality writes the same report of the written mesh
+  r = run({"quality", path("m.vtk"), "--html", path("q.html")});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(contains(slurp(path("q.html")), "<h1>m.vtk</h1>"));
+  // a failed run writes no report
+  r = run({"mesh", write("odd.obj", obj_text(test::prism_radial_soup())), "-o", path("x.vtk"),
+           "--html", path("x.html"), "-q"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_FALSE(fs::exists(path("x.html")));
+
+  if (std::system("command -v chromium > /dev/null 2>&1") != 0)
+    GTEST_SKIP() << "chromium is not installed (Debian: apt-get install chromium)";
+  const std::string flags = "--headless --no-sandbox --use-gl=angle --use-angle=swiftshader "
+                            "--enable-unsafe-swiftshader --enable-logging=stderr --v=0 "
+                            "--window-size=900,1500 --virtual-time-budget=10000 --user-data-dir='" +
+                            path("profile") + "' ";
+  const std::string url = "'file://" + path("m.html") + "'";
+  ASSERT_EQ(std::system(("timeout 120 chromium " + flags + "--dump-dom " + url + " > '" +
+                         path("dom.txt") + "' 2> '" + path("chromium.log") + "'").c_str()), 0)
+      << slurp(path("chromium.log"));
+  const std::string dom = slurp(path("dom.txt"));
+  const size_t div = dom.find("id=\"status\"");
+  ASSERT_NE(div, std::string::npos);
+  const size_t at = dom.find("viewer-ready: ", div);
+  ASSERT_TRUE(at != std::string::npos && at < dom.find('<', div)) << dom.substr(div, 200);
+  // "viewer-ready: F faces drawn of H hexes, P pixels": the view covers a good part of the canvas
+  const std::string line = dom.substr(at, dom.find('<', at) - at);
+  const long pixels = std::atol(line.substr(line.rfind(", ") + 2).c_str());
+  EXPECT_GT(pixels, 20000) << line;
+  EXPECT_FALSE(contains(slurp(path("chromium.log")), "INFO:CONSOLE")) << slurp(path("chromium.log"));
+  // and the screenshot is not blank: many non-white pixels in the view's part of the page
+  ASSERT_EQ(std::system(("timeout 120 chromium " + flags + "--screenshot='" + path("m.png") +
+                         "' " + url + " > /dev/null 2>&1").c_str()), 0);
+  ASSERT_TRUE(fs::exists(path("m.png")));
+  if (std::system("/usr/bin/python3 -c 'import vtk' > /dev/null 2>&1") != 0) return;
+  spit(path("png.py"),
+       "import sys, vtk\n"
+       "from vtk.util.numpy_support import vtk_to_numpy\n"
+       "r = vtk.vtkPNGReader(); r.SetFileName(sys.argv[1]); r.Update()\n"
+       "img = r.GetOutput(); w, h, _ = img.GetDimensions()\n"
+       "a = vtk_to_numpy(img.GetPointData().GetScalars()).reshape(h, w, -1)[:, :, :3]\n"
+       "lower = a[: h // 2]  # VTK rows run bottom up: the lower half of the page holds the view\n"
+       "colored = ((lower.max(axis=2).astype(int) - lower.min(axis=2)) > 40).sum()\n"
+       "print(colored); sys.exit(0 if colored > 20000 else 1)\n");
+  EXPECT_EQ(std::system(("/usr/bin/python3 '" + path("png.py") + "' '" + path("m.png") + "' > '" +
+                         path("png.log") + "' 2>&1").c_str()), 0)
+      << slurp(path("png.log"));
+}
+
 TEST_F(Cli, MeshRejectsUnknownOutputExtensionFirst) {
   // the input does not even exist: the output extension is reported before any reading
   Outcome r = run({"mesh", path("missing.obj"), "-o", path("out.stl")});
