@@ -155,6 +155,17 @@ constexpr const char* kScript = R"JS(
   var buf = { p: gl.createBuffer(), n: gl.createBuffer(), c: gl.createBuffer(), e: gl.createBuffer() };
   var triangles = 0, segments = 0;
   var axisSel = document.getElementById('axis'), cutSlider = document.getElementById('cut'), worstBox = document.getElementById('worst');
+  // The address's #fragment may set the view: figure (the canvas alone), axis=0..2, cut=0..1000,
+  // worst=0|1, yaw=, pitch= (radians), zoom=.
+  var opts = {};
+  location.hash.slice(1).split('&').forEach(function (kv) { var p = kv.split('='); if (p[0]) opts[p[0]] = p.length > 1 ? p[1] : '1'; });
+  if ('axis' in opts) axisSel.value = opts.axis;
+  if ('cut' in opts) cutSlider.value = opts.cut;
+  if ('worst' in opts) worstBox.checked = opts.worst !== '0';
+  if ('figure' in opts) {
+    Array.prototype.forEach.call(document.body.children, function (e) { if (e !== canvas) e.style.display = 'none'; });
+    document.body.style.margin = '0'; canvas.style.border = 'none';
+  }
   var worst = D.worst;
   function build() {
     var axis = +axisSel.value, t = +cutSlider.value / 1000;
@@ -187,7 +198,7 @@ constexpr const char* kScript = R"JS(
     for (var i = 0; i < px.length; i += 4) if (px[i] < 250 || px[i + 1] < 250 || px[i + 2] < 250) covered++;
     say('viewer-ready: ' + (triangles / 2) + ' faces drawn of ' + nh + ' hexes, ' + covered + ' pixels');
   }
-  var yaw = 0.6, pitch = -0.5, zoom = 1;
+  var yaw = 'yaw' in opts ? +opts.yaw : 0.6, pitch = 'pitch' in opts ? +opts.pitch : -0.5, zoom = 'zoom' in opts ? +opts.zoom : 1;
   function draw() {
     var w = canvas.clientWidth, h = canvas.clientHeight;
     if (canvas.width !== w || canvas.height !== h) { canvas.width = w; canvas.height = h; }
