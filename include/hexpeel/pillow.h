@@ -47,23 +47,21 @@ struct PillowParams {
   /// A forced corner whose scaled Jacobian (det of unit edge vectors) is <= this counts as a
   /// forced configuration (dimensionless, in [-1, 1)). Below 0 the hex is inverted whatever the
   /// placement; 0.2 (two boundary faces within ~12 deg of flat) also pillows corners that would
-  /// cap the mesh's minimum at a useless value (csphere_n12: 0.07 without, 0.6 with).
+  /// cap the mesh's minimum at a useless value.
   double forced_sj = 0.2;
   /// Rings of face neighbours added to the forced hexes to make the local shrink set (0..10):
   /// a larger set spreads the pillow's distortion over more hexes.
   int grow = 2;
   /// In auto mode, pillow the whole boundary instead when the local shrink set holds at least
-  /// this fraction of the hexes that touch the boundary (in [0, 1]; 1 = always local). Measured:
-  /// on cubed spheres and pillowed grids the whole layer then gives the higher minimum
-  /// (csphere_n12 0.77 vs 0.51), while sparse forced corners are better served locally.
+  /// this fraction of the hexes that touch the boundary (in [0, 1]; 1 = always local): dense
+  /// forced corners are better served by the whole layer, sparse ones locally.
   double whole_fraction = 0.25;
   /// Inward margin (unit normals, 0..1) a boundary vertex's copy should have over the quads the
   /// pillow puts at it: the pillow hexes' corners at the copy cannot be better than about this
   /// margin, so at a vertex below it hexes that are not forced are kept out of S while that
   /// raises the smaller of the copy's margin and the one left for the hexes kept out (0 = only
-  /// what a copy needs to exist, a margin of 1e-3). Off by default: on two genus-0 cuts of a real
-  /// hex mesh, 0.1 raised one minimum (0.0375 -> 0.106) and left the other with inverted hexes
-  /// (0.0197 -> -0.061 for its first order).
+  /// what a copy needs to exist, a margin of 1e-3). Off by default: it can raise the minimum but
+  /// can also leave hexes inverted.
   double target_margin = 0.0;
   /// Pillow passes at most (values below 1 count as 1). A pass after the first pillows, locally, forced hexes the
   /// previous one had to keep out of S (at a saddle vertex), giving that vertex another copy; it

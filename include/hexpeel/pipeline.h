@@ -38,9 +38,8 @@ struct MeshParams {
   /// pillowed whole, the complex is pillowed again, counting as forced every corner up to the
   /// minimum plus this band, and placed and optimized again; the retry is kept when it leaves
   /// fewer hexes <= 0, or as many and raises the minimum by more than it lowers the mean
-  /// (PillowRetryStats). 0 = no retry. Coarse smooth surfaces with no forced configuration are
-  /// where it acts: a 90-quad ellipsoid from a published dataset, 50 hexes at 0.41 / 0.70, gets
-  /// the whole layer, 140 hexes at 0.73 / 0.85 (its published mesh: 0.52 / 0.81).
+  /// (PillowRetryStats). 0 = no retry. It acts mostly on coarse smooth surfaces with no forced
+  /// configuration.
   double pillow_retry_band = 0.1;
   /// Repair rounds (>= 0, 0 = none): while the untangled mesh keeps hexes with SJ <= 0, its
   /// complex is pillowed once more, locally around those hexes (each grown by PillowParams::grow

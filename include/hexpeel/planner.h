@@ -29,7 +29,7 @@ struct PlannerParams {
   OrderParams order;            ///< priorities and side rule (run_mesh passes its own, with
                                 ///< SideRule::cost, the planner's default)
   /// Budget of the whole search in budget seconds (> 0): work, counted deterministically, of
-  /// about a wall-clock second each on the reference machine (0.75-1.1 s measured).
+  /// about a wall-clock second each on the reference machine.
   double budget_s = 30.0;
   /// Budget for looking for a cheaper plan once one was found by backtracking (beam + restarts),
   /// within budget_s (budget seconds, >= 0).

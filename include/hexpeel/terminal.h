@@ -30,9 +30,8 @@ struct TerminalParams {
   bool enabled = true;
   /// Largest stuck surface (quads) a fill is tried on; larger ones stay stuck (> 0).
   int32_t max_quads = 400;
-  /// Pits (discs F) tried at most on one stuck surface, over all depths (> 0). A try whose
-  /// surface is dead at once costs about 0.2 ms; a 94-quad stuck surface of a cut of pierrot's
-  /// mesh has 725 pits, and its descent (depth 4) tried 10208 in 1.8 s (issue 6).
+  /// Pits (discs F) tried at most on one stuck surface, over all depths (> 0). High, since a try
+  /// whose surface is dead at once is cheap and a nested descent tries many pits.
   int32_t max_tries = 30000;
   /// Nested fills at most: a pit surface that gets stuck on a smaller surface is filled in turn
   /// (>= 1; 1 = the pits of the stuck surface alone).
@@ -44,7 +43,7 @@ struct TerminalParams {
   double budget_s = 1.0;
   /// Planning work of the whole fill, all pits and depths, in budget seconds (> 0), each try
   /// also charged 1e-6 per quad of its pit surface for the set-up. Most pit surfaces are dead at
-  /// once (no chord can go), so a fill usually takes a few milliseconds.
+  /// once (no chord can go), so a fill usually costs far less.
   double total_budget_s = 10.0;
   /// Sharp angle of the pit surfaces' edge classification (degrees; the mesh's own).
   double sharp_angle_deg = 60.0;
