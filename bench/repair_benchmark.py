@@ -3,6 +3,7 @@
 folder made by bench/gmsh_quad_surfaces.sh, against gmsh's own all-hex mesh of the same solid.
 
   bench/repair_benchmark.py DIR [--hexpeel build/hexpeel] [--timeout 60] [--out OUTDIR]
+                              [--extra "--repair-tets only ..."]
 
 Prints one markdown row per surface (input quads, odd, self-crossings, refined quads, status,
 hexes, min / mean SJ, wall seconds, gmsh's hexes and min / mean SJ from DIR/hexref/SOLID.msh)
@@ -37,13 +38,14 @@ def main():
     ap.add_argument("--hexpeel", default=os.path.join(os.path.dirname(__file__), "..", "build", "hexpeel"))
     ap.add_argument("--timeout", type=float, default=60.0)
     ap.add_argument("--out", default="repair_bench_out")
+    ap.add_argument("--extra", default="", help="more options for hexpeel mesh, one string")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
     names = sorted(f[:-4] for f in os.listdir(a.dir) if f.endswith(".obj"))
     cache = {}
-    print("| surface | quads | odd | self-crossings | refined quads | status | hexes | min SJ | "
+    print("| surface | quads | odd | self-crossings | refined quads | via | status | hexes | min SJ | "
           "mean SJ | s | gmsh hexes | gmsh min SJ | gmsh mean SJ |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     rows = []
     for n in names:
         rep = os.path.join(a.out, n + ".json")
@@ -53,7 +55,8 @@ def main():
         try:
             p = subprocess.run([a.hexpeel, "mesh", os.path.join(a.dir, n + ".obj"), "-o",
                                 os.path.join(a.out, n + ".vtk"), "--repair-surface", "--report",
-                                rep, "--quiet"], capture_output=True, text=True, timeout=a.timeout)
+                                rep, "--quiet"] + a.extra.split(), capture_output=True, text=True,
+                               timeout=a.timeout)
             status = None
         except subprocess.TimeoutExpired:
             status = "timeout"
@@ -64,11 +67,14 @@ def main():
         sj = j.get("scaled_jacobian", {})
         ref = gmsh_reference(a.hexpeel, os.path.join(a.dir, "hexref", re.sub(r"_[bdsq]$", "", n) + ".msh"), cache)
         ok = status == "ok" and sj.get("count_nonpositive", 1) == 0
+        # which mesh was kept: the grown refinement's, the all-six split's, or the tet fill's
+        via = ("tets" if (r.get("tet_fill") or {}).get("kept") else
+               "six" if r.get("six_split_count") == r.get("input_quads") else "grown") if r else "-"
         rows.append((n, status, ok, sj.get("min"), sj.get("mean"), secs, ref, r))
         f = lambda x: "-" if x is None else ("%.3f" % x if isinstance(x, float) else str(x))
-        print("| %s | %s | %s | %s | %s | %s | %s | %s | %s | %.1f | %s | %s | %s |" % (
+        print("| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %.1f | %s | %s | %s |" % (
             n, f(r.get("input_quads")), "yes" if r.get("input_odd") else "", f(r.get("input_self_crossings")),
-            f(r.get("output_quads")), status, f(j.get("hexes")), f(sj.get("min")), f(sj.get("mean")), secs,
+            f(r.get("output_quads")), via, status, f(j.get("hexes")), f(sj.get("min")), f(sj.get("mean")), secs,
             f(ref and ref[0]), f(ref and ref[1]), f(ref and ref[2])), flush=True)
     valid = [x for x in rows if x[2]]
     above = [x for x in valid if x[6] and x[3] > x[6][1]]

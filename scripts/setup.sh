@@ -8,7 +8,7 @@ cd "$(dirname "$0")/.."
 PACKAGES=(
   build-essential cmake ninja-build pkg-config
   libeigen3-dev libtbb-dev libcli11-dev nlohmann-json3-dev zlib1g-dev liblbfgspp-dev libsuitesparse-dev
-  libexodusii-dev
+  libexodusii-dev libgmsh-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-numpy python3-vtk9 python3-meshio python3-netcdf4
   pybind11-dev python3-dev

@@ -24,6 +24,7 @@
 #include "hexpeel/io.h"
 #include "hexpeel/pipeline.h"
 #include "hexpeel/quality.h"
+#include "hexpeel/tet_fill.h"
 
 #include <algorithm>
 #include <filesystem>
@@ -129,8 +130,11 @@ int cmd_check(const std::string& in, double sharp_angle, const std::string& json
     if (e.validation.status.ok()) {
       const SurfaceRepair rep = repair_surface(e.validation.surface);
       if (rep.status.ok())
-        std::printf("with --repair-surface: refined into %d quads (%zu of %d split into six, the "
-                    "rest into four), every chord simple: `mesh --repair-surface` would mesh that\n",
+        std::printf("with --repair-surface: split into six, %d quads, filled through tetrahedra%s "
+                    "(--repair-fill elimination: refined into %d quads, %zu of %d split into six, "
+                    "the rest into four, every chord simple)\n",
+                    6 * rep.stats.input_quads,
+                    tet_fill_available() ? "" : " (not in this build: no gmsh library)",
                     rep.stats.output_quads, rep.stats.six_split.size(), rep.stats.input_quads);
       else
         std::printf("with --repair-surface: %s\n", rep.status.message.c_str());
@@ -403,10 +407,16 @@ int main(int argc, char** argv) {
   mesh->add_option("--html", html_out,
                    "also write an HTML quality report: figures, histogram, worst hexes, 3D view "
                    "with a cutaway plane (self-contained; open it in a browser)");
+  std::string repair_fill = "tets";
+  mesh->add_option("--repair-fill", repair_fill,
+                   "with --repair-surface: tets = the surface split into six, filled through "
+                   "tetrahedra (4 hexes each); elimination = the refined surface by dual cycle "
+                   "elimination; both = both, the better mesh kept")
+      ->check(CLI::IsMember({"tets", "elimination", "both"}))->capture_default_str();
   mesh->add_flag("--repair-surface", params.repair_surface,
-                 "a surface with a self-crossing chord or an odd quad count is refined into one "
-                 "hexpeel can mesh (input vertices kept, every quad split into 4 or 6) and that "
-                 "is meshed; see docs/cli.md");
+                 "a surface with a self-crossing chord or an odd quad count is refined (input "
+                 "vertices kept, every quad split into 6) and that is meshed; the mesh's boundary "
+                 "is the refined surface; see docs/cli.md");
   mesh->add_option("--repaired-surface", repaired_out,
                    "with --repair-surface: also write the mesh's boundary surface (.obj .off)");
   bool patch_sets = false;
@@ -602,6 +612,7 @@ int main(int argc, char** argv) {
   mesh->set_help_all_flag("--help-all", "print every option, the expert ones too, and exit");
   for (CLI::Option* o : mesh->get_options()) {
     static const char* const kEveryday[] = {"help", "help-all", "output", "report", "html", "dump-stuck",
+                                            "repair-fill",
                                             "repair-surface", "repaired-surface", "patch-sets",
                                             "sharp-angle", "effort", "plan-budget", "pillow",
                                             "threads", "quiet"};
@@ -638,6 +649,9 @@ int main(int argc, char** argv) {
       params.terminal.enabled = !no_stuck_fill;
       params.elimination.order.side_rule = side_rule == "cost" ? SideRule::cost : SideRule::heavier;
       params.sharp_angle_deg = sharp_angle;
+      params.repair_fill = repair_fill == "elimination" ? MeshParams::RepairFill::elimination
+                           : repair_fill == "both"        ? MeshParams::RepairFill::both
+                                                          : MeshParams::RepairFill::tets;
       params.pillow.mode = pillow == "all"    ? PillowMode::all
                            : pillow == "none" ? PillowMode::none
                                               : PillowMode::automatic;

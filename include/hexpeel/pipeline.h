@@ -13,6 +13,7 @@
 #include "hexpeel/quality.h"
 #include "hexpeel/reconstruction.h"
 #include "hexpeel/surface_repair.h"
+#include "hexpeel/tet_fill.h"
 #include "hexpeel/terminal.h"
 #include "hexpeel/untangle.h"
 
@@ -28,6 +29,13 @@ struct MeshParams {
   /// without (surface_repair.h) and that is meshed: the mesh's boundary is the repaired
   /// surface. Off: such a surface is refused.
   bool repair_surface = false;
+  /// How the repaired surface is filled: tets = the surface split into six everywhere, filled
+  /// through tetrahedra (tet_fill.h); elimination = the refined surface (split into six around
+  /// the self-crossings, into four elsewhere) by dual cycle elimination, then the one split into
+  /// six everywhere when that mesh keeps hexes <= 0; both = elimination and tets, the better
+  /// mesh kept (better_result).
+  enum class RepairFill { tets, elimination, both };
+  RepairFill repair_fill = RepairFill::tets;
   bool search = true;             ///< plan with the search portfolio (planner.h); false = plain greedy
   PlannerParams planner;          ///< budget, seed, side rule (its `order` is taken from `elimination`)
   TerminalParams terminal;        ///< filling the surface elimination got stuck on
@@ -147,6 +155,10 @@ struct MeshResult {
   QuadSurface stuck_surface;     ///< when elimination got stuck: the surface it stopped at
   SurfaceRepairStats repair;     ///< MeshParams::repair_surface: what the repair changed
   QuadSurface repaired_surface;  ///< ... and the surface it made (the mesh's boundary)
+  /// The repair's last resort (tet_fill.h), when the refined surfaces did not mesh with every
+  /// hex positive: tetrahedra > 0 when it was tried.
+  TetFillStats tet_fill;
+  bool tet_fill_kept = false;    ///< ... and its mesh is the one returned
   MeshTimings timings;
   OrderParams method;            ///< the elimination order (method and rules) this run used
   std::vector<OrderTry> tries;   ///< every order tried, the given one first (empty when the

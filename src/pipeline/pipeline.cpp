@@ -604,7 +604,9 @@ static MeshResult mesh_repaired(const SurfaceDiagnosis& diagnosis, const MeshPar
   inner.validation.allow_odd = false;
   MeshResult best;
   double others_s = 0.0;
+  const bool eliminate = params.repair_fill != MeshParams::RepairFill::tets;
   for (const bool everywhere : {false, true}) {
+    if (!eliminate) break;
     const auto t = std::chrono::steady_clock::now();
     SurfaceRepair rep = repair_surface(diagnosis.validation.surface, everywhere);
     const double repair_s = seconds_since(t);
@@ -641,6 +643,53 @@ static MeshResult mesh_repaired(const SurfaceDiagnosis& diagnosis, const MeshPar
       best = std::move(r);
     } else {
       others_s += total_seconds(r.timings);
+    }
+  }
+  // The last resort: the surface split into six everywhere, filled through tetrahedra
+  // (tet_fill.h), placed and optimized like any complex.
+  if (!eliminate && !tet_fill_available()) {
+    best.status = tet_fill(diagnosis.validation.surface, QuadSurface{}).status;
+    best.diagnosis = diagnosis;
+  }
+  if (params.repair_fill != MeshParams::RepairFill::elimination && tet_fill_available()) {
+    const auto t = std::chrono::steady_clock::now();
+    SurfaceRepair rep = repair_surface(diagnosis.validation.surface, true);
+    if (!rep.status.ok() && !eliminate) {
+      best.status = rep.status;
+      best.diagnosis = diagnosis;
+      best.repair = rep.stats;
+    }
+    if (rep.status.ok()) {
+      ctx.info("filling the surface split into six through tetrahedra");
+      TetFill tf = tet_fill(diagnosis.validation.surface, rep.surface);
+      MeshResult r;
+      r.method = params.elimination.order;
+      r.repair = rep.stats;
+      r.tet_fill = tf.stats;
+      r.status = tf.status;
+      r.diagnosis = diagnose_surface(to_polygon_soup(rep.surface), params.sharp_angle_deg, {},
+                                     inner.validation);
+      r.timings.check_s = check_s + seconds_since(t);
+      if (tf.status.ok()) {
+        r.reconstruction.hexes = static_cast<int32_t>(tf.complex.hexes.size());
+        embed(rep.surface, tf.complex, inner, inner.pillow, ctx, r, &r.complex);
+      } else {
+        ctx.warn("the repair's tetrahedral fallback failed: " + tf.status.message);
+      }
+      r.repaired_surface = std::move(rep.surface);
+      if (!eliminate || (r.status.ok() && better_result(r, best))) {
+        if (r.status.ok())
+          ctx.warn("surface repaired (--repair-surface): " + std::to_string(r.repair.input_quads) +
+                   " quads -> " + std::to_string(r.repair.output_quads) + " quads (every quad split "
+                   "into six), filled through " + std::to_string(r.tet_fill.tetrahedra) +
+                   " tetrahedra (4 hexes each); the mesh's boundary is the repaired surface, not the input");
+        others_s += total_seconds(best.timings);
+        r.tet_fill_kept = true;
+        best = std::move(r);
+      } else {
+        others_s += total_seconds(r.timings);
+        best.tet_fill = r.tet_fill;
+      }
     }
   }
   best.timings.other_orders_s += others_s;

@@ -14,7 +14,14 @@ nlohmann::json to_json(const MeshResult& r) {
   j["status"] = std::string(to_string(r.status.code));
   j["message"] = r.status.message;
   j["input"] = to_json(r.diagnosis);
-  if (r.repair.input_quads > 0) j["repair"] = to_json(r.repair);  // the repair was tried
+  if (r.repair.input_quads > 0) {  // the repair was tried
+    j["repair"] = to_json(r.repair);
+    if (r.tet_fill.tetrahedra > 0)
+      j["repair"]["tet_fill"] = {{"tetrahedra", r.tet_fill.tetrahedra},
+                                 {"interior_nodes", r.tet_fill.interior_nodes},
+                                 {"time_s", r.tet_fill.time_s},
+                                 {"kept", r.tet_fill_kept}};
+  }
   const ChordStats& cs = r.diagnosis.chord_stats;
   j["chords"] = {{"count", cs.count},
                  {"min_length", cs.min_length},

@@ -832,7 +832,7 @@ TEST_F(Cli, RepairSurfaceMeshesRefusedSurfacesAndWritesTheBoundary) {
   // check tells what the repair would do
   r = run({"check", in});
   EXPECT_EQ(r.exit_code, 2) << r.err;
-  EXPECT_TRUE(contains(r.out, "with --repair-surface: refined into")) << r.out;
+  EXPECT_TRUE(contains(r.out, "with --repair-surface: split into six, 54 quads")) << r.out;
   // --repaired-surface alone is a usage error, before anything is read or written
   r = run({"mesh", in, "-o", path("out.vtk"), "--repaired-surface", path("rep.obj")});
   EXPECT_EQ(r.exit_code, 2) << r.err;

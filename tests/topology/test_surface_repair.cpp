@@ -3,6 +3,7 @@
 
 #include "hexpeel/chords.h"
 #include "hexpeel/pipeline.h"
+#include "hexpeel/tet_fill.h"
 #include "soups.h"
 
 #include <gtest/gtest.h>
@@ -109,6 +110,7 @@ void expect_meshes_repaired(const PolygonSoup& soup) {
   // ... and meshed with it: a ball, every hex positive, boundary = the repaired surface
   MeshParams p;
   p.repair_surface = true;
+  p.repair_fill = MeshParams::RepairFill::elimination;
   const MeshResult r = run_mesh(soup, p);
   ASSERT_TRUE(r.status.ok()) << to_string(r.status);
   EXPECT_TRUE(r.repair.applied);
@@ -126,6 +128,63 @@ void expect_meshes_repaired(const PolygonSoup& soup) {
 
 TEST(SurfaceRepair, PipelineMeshesSelfCrossingSurface) { expect_meshes_repaired(square_pyramid_radial()); }
 TEST(SurfaceRepair, PipelineMeshesOddSurface) { expect_meshes_repaired(test::prism_radial_soup()); }
+
+/// The tet split itself: a ball whose boundary is the surface split into six everywhere, vertex
+/// for vertex; on planar parallelogram quads (`positive`) every hex positive where it puts them.
+void expect_tet_fill(const PolygonSoup& soup, bool positive) {
+  if (!tet_fill_available()) GTEST_SKIP() << "built without gmsh's library";
+  const QuadSurface in = test::to_surface(soup);
+  std::vector<int32_t> parent;
+  const QuadSurface six = refine_surface(in, std::vector<char>(in.num_quads(), 1), parent);
+  const TetFill tf = tet_fill(in, six);
+  ASSERT_TRUE(tf.status.ok()) << to_string(tf.status);
+  EXPECT_GT(tf.stats.tetrahedra, 0);
+  EXPECT_EQ(tf.complex.hexes.size(), 4u * tf.stats.tetrahedra);
+  ASSERT_EQ(tf.points.size(), static_cast<size_t>(tf.complex.num_vertices));
+  for (int32_t v = 0; v < six.num_points(); ++v) {
+    EXPECT_EQ(tf.complex.input_vertex[v], v);
+    EXPECT_EQ(tf.points[v], six.points[v]);
+  }
+  for (size_t v = six.num_points(); v < tf.points.size(); ++v) EXPECT_EQ(tf.complex.input_vertex[v], -1);
+  const HexMesh m{tf.points, tf.complex.hexes};
+  const QualityReport q = run_quality(m, {}, &six);
+  EXPECT_TRUE(q.is_ball) << q.topology_message;
+  EXPECT_EQ(q.boundary_matches_surface, true) << q.boundary_message;
+  if (positive) {
+    EXPECT_EQ(q.sj_count_nonpositive, 0);
+    EXPECT_GT(q.sj_min, 0.0);
+  }
+}
+
+TEST(SurfaceRepair, TetFillOfSelfCrossingSurface) { expect_tet_fill(square_pyramid_radial(), false); }
+TEST(SurfaceRepair, TetFillOfOddSurface) { expect_tet_fill(test::prism_radial_soup(), false); }
+TEST(SurfaceRepair, TetFillOfCube) { expect_tet_fill(test::cube_soup(), true); }
+
+TEST(SurfaceRepair, PipelineMeshesThroughTetrahedra) {
+  if (!tet_fill_available()) GTEST_SKIP() << "built without gmsh's library";
+  MeshParams p;
+  p.repair_surface = true;
+  p.repair_fill = MeshParams::RepairFill::tets;
+  const PolygonSoup soup = square_pyramid_radial();
+  const MeshResult r = run_mesh(soup, p);
+  ASSERT_TRUE(r.status.ok()) << to_string(r.status);
+  EXPECT_TRUE(r.tet_fill_kept);
+  EXPECT_EQ(r.repaired_surface.num_quads(), 6 * soup.num_faces());
+  const QualityReport q = run_quality(r.mesh, {}, &r.repaired_surface);
+  EXPECT_TRUE(q.is_ball) << q.topology_message;
+  EXPECT_EQ(q.boundary_matches_surface, true) << q.boundary_message;
+  EXPECT_EQ(q.sj_count_nonpositive, 0);
+  for (size_t v = 0; v < soup.points.size(); ++v) EXPECT_EQ(r.mesh.points[v], soup.points[v]);
+  const nlohmann::json j = to_json(r);
+  EXPECT_EQ(j["repair"]["tet_fill"]["kept"], true);
+  EXPECT_GT(j["repair"]["tet_fill"]["tetrahedra"], 0);
+  // elimination: the elimination's mesh, no tet section
+  p.repair_fill = MeshParams::RepairFill::elimination;
+  const MeshResult e = run_mesh(soup, p);
+  ASSERT_TRUE(e.status.ok());
+  EXPECT_FALSE(e.tet_fill_kept);
+  EXPECT_FALSE(to_json(e)["repair"].contains("tet_fill"));
+}
 
 TEST(SurfaceRepair, SurfaceThatNeedsNoneIsMeshedAsIs) {
   // the option changes nothing on a surface the mesher takes: same mesh, no repair section
