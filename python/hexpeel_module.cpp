@@ -190,7 +190,7 @@ std::unique_ptr<tbb::global_control> thread_limit(int threads) {
 }
 
 py::tuple mesh(const py::object& points, const py::object& quads, double sharp_angle,
-               double plan_budget, int threads, bool repair_surface) {
+               double plan_budget, int threads, bool repair_surface, const std::string& repair_fill) {
   check_sharp_angle(sharp_angle);
   if (!(plan_budget >= 0.0) || !std::isfinite(plan_budget))
     fail_argument("plan_budget must be a finite number >= 0");
@@ -199,6 +199,10 @@ py::tuple mesh(const py::object& points, const py::object& quads, double sharp_a
   params.sharp_angle_deg = sharp_angle;
   params.planner.budget_s = plan_budget;
   params.repair_surface = repair_surface;
+  if (repair_fill == "tets") params.repair_fill = MeshParams::RepairFill::tets;
+  else if (repair_fill == "elimination") params.repair_fill = MeshParams::RepairFill::elimination;
+  else if (repair_fill == "both") params.repair_fill = MeshParams::RepairFill::both;
+  else fail_argument("repair_fill must be 'tets', 'elimination' or 'both', got '" + repair_fill + "'");
   Warnings warnings;
   MeshResult r;
   {
@@ -309,9 +313,9 @@ PYBIND11_MODULE(_hexpeel, m) {
 
   m.def("mesh", &mesh, py::arg("points"), py::arg("quads"), py::kw_only(),
         py::arg("sharp_angle") = 60.0, py::arg("plan_budget") = 30.0, py::arg("threads") = 0,
-        py::arg("repair_surface") = false,
+        py::arg("repair_surface") = false, py::arg("repair_fill") = "tets",
         "mesh(points, quads, *, sharp_angle=60.0, plan_budget=30.0, threads=0,\n"
-        "     repair_surface=False)\n--\n\n"
+        "     repair_surface=False, repair_fill='tets')\n--\n\n"
         "-> (points, hexes, report)\n\n"
         "Fills a closed genus-0 all-quad surface with hexahedra (as `hexpeel mesh`).\n\n"
         "points: (N, 3) float64 vertex coordinates; quads: (M, 4) integer 0-based vertex ids.\n"
@@ -325,6 +329,8 @@ PYBIND11_MODULE(_hexpeel, m) {
         "repair_surface: refine a surface with self-crossing chords or an odd count and\n"
         "mesh that (`--repair-surface`): the hexes' boundary is the refined surface, the\n"
         "input vertices come first; report['repair'] says what changed.\n"
+        "repair_fill: how (`--repair-fill`): 'tets' (the surface split into six, filled\n"
+        "through tetrahedra), 'elimination' or 'both' (the better mesh kept).\n"
         "The GIL is released while meshing. Raises hexpeel.Error.");
   m.def("check", &check, py::arg("points"), py::arg("quads"), py::kw_only(),
         py::arg("sharp_angle") = 60.0,

@@ -289,7 +289,7 @@ class MeshTest(unittest.TestCase, HexMeshChecks):
         sig = inspect.signature(hexpeel.mesh)
         self.assertEqual(list(sig.parameters),
                          ["points", "quads", "sharp_angle", "plan_budget", "threads",
-                          "repair_surface"])
+                          "repair_surface", "repair_fill"])
         self.assertEqual(sig.parameters["sharp_angle"].default, 60.0)
         self.assertTrue(hexpeel.__doc__)
 
@@ -336,6 +336,19 @@ class ErrorTest(unittest.TestCase):
         self.assertEqual(report["scaled_jacobian"]["count_nonpositive"], 0)
         self.assertEqual(len(hexes), report["hexes"])
         np.testing.assert_array_equal(out_pts[: len(pts)], np.asarray(pts, dtype=float))
+
+    def test_repair_fill(self):
+        pts, quads = prism_radial()
+        with self.assertWarnsRegex(UserWarning, "surface repaired"):
+            _, tets, rt = hexpeel.mesh(pts, quads, repair_surface=True, repair_fill="tets")
+        self.assertTrue(rt["repair"]["tet_fill"]["kept"])
+        self.assertEqual(len(tets), 4 * rt["repair"]["tet_fill"]["tetrahedra"])
+        with self.assertWarnsRegex(UserWarning, "surface repaired"):
+            _, elim, re_ = hexpeel.mesh(pts, quads, repair_surface=True, repair_fill="elimination")
+        self.assertNotIn("tet_fill", re_["repair"])
+        self.assertEqual(re_["scaled_jacobian"]["count_nonpositive"], 0)
+        self.assert_error("invalid_argument", hexpeel.mesh, pts, quads, repair_surface=True,
+                          repair_fill="octree")
 
     def test_torus(self):
         pts, quads = torus()
