@@ -15,9 +15,10 @@
 #include <map>
 #include <mutex>
 #include <string>
+#include <type_traits>
 
 #ifdef HEXPEEL_HAVE_GMSH
-#include <gmsh.h>
+#include <dlfcn.h>
 #endif
 
 namespace hexpeel {
@@ -39,6 +40,63 @@ TetFill tet_fill(const QuadSurface&, const QuadSurface&) {
 namespace {
 
 std::mutex gmsh_mutex;  // gmsh keeps one global model
+
+/// gmsh's C API (gmshc.h, 4.8), loaded from its shared library the first time the fill is
+/// needed, so that hexpeel starts without it and runs where it is missing (the fill then says
+/// so). Every function reports errors through its last argument.
+struct GmshApi {
+  void (*initialize)(int, char**, const int, int*) = nullptr;
+  void (*finalize)(int*) = nullptr;
+  void (*set_number)(const char*, const double, int*) = nullptr;
+  void (*model_add)(const char*, int*) = nullptr;
+  int (*add_discrete_entity)(const int, const int, int*, size_t, int*) = nullptr;
+  void (*add_nodes)(const int, const int, size_t*, size_t, double*, size_t, double*, size_t, int*) = nullptr;
+  void (*add_elements_by_type)(const int, const int, size_t*, size_t, size_t*, size_t, int*) = nullptr;
+  int (*add_surface_loop)(int*, size_t, const int, int*) = nullptr;
+  int (*add_volume)(int*, size_t, const int, int*) = nullptr;
+  void (*synchronize)(int*) = nullptr;
+  void (*generate)(const int, int*) = nullptr;
+  void (*get_nodes)(size_t**, size_t*, double**, size_t*, double**, size_t*, const int, const int,
+                    const int, const int, int*) = nullptr;
+  void (*get_elements_by_type)(const int, size_t**, size_t*, size_t**, size_t*, const int,
+                               const size_t, const size_t, int*) = nullptr;
+  void (*free)(void*) = nullptr;
+  void (*last_error)(char**, int*) = nullptr;
+  bool loaded = false;
+};
+
+/// The API, loaded once (never unloaded); `loaded` false when the library or a symbol is missing.
+const GmshApi& gmsh_api() {
+  static const GmshApi api = [] {
+    GmshApi a;
+    void* lib = dlopen("libgmsh.so.4.8", RTLD_NOW | RTLD_LOCAL);
+    if (lib == nullptr) lib = dlopen("libgmsh.so", RTLD_NOW | RTLD_LOCAL);
+    if (lib == nullptr) return a;
+    bool ok = true;
+    auto sym = [&](auto& f, const char* name) {
+      f = reinterpret_cast<std::remove_reference_t<decltype(f)>>(dlsym(lib, name));
+      ok = ok && f != nullptr;
+    };
+    sym(a.initialize, "gmshInitialize");
+    sym(a.finalize, "gmshFinalize");
+    sym(a.set_number, "gmshOptionSetNumber");
+    sym(a.model_add, "gmshModelAdd");
+    sym(a.add_discrete_entity, "gmshModelAddDiscreteEntity");
+    sym(a.add_nodes, "gmshModelMeshAddNodes");
+    sym(a.add_elements_by_type, "gmshModelMeshAddElementsByType");
+    sym(a.add_surface_loop, "gmshModelGeoAddSurfaceLoop");
+    sym(a.add_volume, "gmshModelGeoAddVolume");
+    sym(a.synchronize, "gmshModelGeoSynchronize");
+    sym(a.generate, "gmshModelMeshGenerate");
+    sym(a.get_nodes, "gmshModelMeshGetNodes");
+    sym(a.get_elements_by_type, "gmshModelMeshGetElementsByType");
+    sym(a.free, "gmshFree");
+    sym(a.last_error, "gmshLoggerGetLastError");
+    a.loaded = ok;
+    return a;
+  }();
+  return api;
+}
 
 using Tri = std::array<int32_t, 3>;
 
@@ -80,40 +138,61 @@ Tri sorted(Tri t) {
 /// points the tetrahedralization adds (appended to `points`).
 Status tetrahedralize(const std::vector<Vec3>& in_points, const std::vector<BoundaryTriangle>& tris,
                       std::vector<Vec3>& points, std::vector<std::array<int32_t, 4>>& tets) {
+  const GmshApi& g = gmsh_api();
+  if (!g.loaded) return Status::error(StatusCode::stuck, "gmsh's library (libgmsh.so.4.8) cannot be loaded");
   const std::lock_guard<std::mutex> lock(gmsh_mutex);
-  try {
-    gmsh::initialize(0, nullptr, false);
-    gmsh::option::setNumber("General.Terminal", 0);
-    gmsh::option::setNumber("General.Verbosity", 0);
-    gmsh::option::setNumber("General.NumThreads", 1);
-    gmsh::option::setNumber("Mesh.Algorithm3D", 1);  // Delaunay
-    gmsh::option::setNumber("Mesh.Optimize", 0);     // no tet optimization: it may move nothing
-                                                     // on the surface, but keep the run simple
-    gmsh::model::add("hexpeel_tet_fill");
-    const int surf = gmsh::model::addDiscreteEntity(2);
-    std::vector<std::size_t> tags(in_points.size());
-    std::vector<double> coord(3 * in_points.size());
-    for (size_t i = 0; i < in_points.size(); ++i) {
-      tags[i] = i + 1;
-      for (int k = 0; k < 3; ++k) coord[3 * i + k] = in_points[i][k];
-    }
-    gmsh::model::mesh::addNodes(2, surf, tags, coord);
-    std::vector<std::size_t> elem(tris.size()), nodes(3 * tris.size());
-    for (size_t i = 0; i < tris.size(); ++i) {
-      elem[i] = i + 1;
-      for (int k = 0; k < 3; ++k) nodes[3 * i + k] = static_cast<std::size_t>(tris[i].corners[k]) + 1;
-    }
-    gmsh::model::mesh::addElementsByType(surf, 2, elem, nodes);
-    const int loop = gmsh::model::geo::addSurfaceLoop({surf});
-    gmsh::model::geo::addVolume({loop});
-    gmsh::model::geo::synchronize();
-    gmsh::model::mesh::generate(3);
-    std::vector<std::size_t> all_tags;
-    std::vector<double> all_coord, param;
-    gmsh::model::mesh::getNodes(all_tags, all_coord, param, -1, -1, false, false);
+  int err = 0;
+  g.initialize(0, nullptr, 0, &err);
+  if (err) return Status::error(StatusCode::stuck, "gmsh's library did not initialize");
+  // The first error decides; later calls are skipped.
+  std::string failure;
+  auto check = [&](const char* what) {
+    if (err == 0 || !failure.empty()) return failure.empty();
+    char* msg = nullptr;
+    int e2 = 0;
+    g.last_error(&msg, &e2);
+    failure = std::string(what) + (msg != nullptr && *msg ? std::string(": ") + msg : std::string());
+    if (msg != nullptr) g.free(msg);
+    return false;
+  };
+  g.set_number("General.Terminal", 0, &err);
+  g.set_number("General.Verbosity", 0, &err);
+  g.set_number("General.NumThreads", 1, &err);
+  g.set_number("Mesh.Algorithm3D", 1, &err);  // Delaunay
+  g.set_number("Mesh.Optimize", 0, &err);     // measured both ways: see docs/benchmarks.md
+  check("options");
+  if (failure.empty()) g.model_add("hexpeel_tet_fill", &err);
+  int surf = -1;
+  if (check("model")) surf = g.add_discrete_entity(2, -1, nullptr, 0, &err);
+  std::vector<std::size_t> tags(in_points.size());
+  std::vector<double> coord(3 * in_points.size());
+  for (size_t i = 0; i < in_points.size(); ++i) {
+    tags[i] = i + 1;
+    for (int k = 0; k < 3; ++k) coord[3 * i + k] = in_points[i][k];
+  }
+  if (check("surface")) g.add_nodes(2, surf, tags.data(), tags.size(), coord.data(), coord.size(), nullptr, 0, &err);
+  std::vector<std::size_t> elem(tris.size()), nodes(3 * tris.size());
+  for (size_t i = 0; i < tris.size(); ++i) {
+    elem[i] = i + 1;
+    for (int k = 0; k < 3; ++k) nodes[3 * i + k] = static_cast<std::size_t>(tris[i].corners[k]) + 1;
+  }
+  if (check("nodes")) g.add_elements_by_type(surf, 2, elem.data(), elem.size(), nodes.data(), nodes.size(), &err);
+  int loop = -1;
+  if (check("triangles")) loop = g.add_surface_loop(&surf, 1, -1, &err);
+  if (check("surface loop")) g.add_volume(&loop, 1, -1, &err);
+  if (check("volume")) g.synchronize(&err);
+  if (check("synchronize")) g.generate(3, &err);
+  size_t *all_tags = nullptr, *tet_tags = nullptr, *tet_nodes = nullptr;
+  double *all_coord = nullptr, *param = nullptr;
+  size_t n_tags = 0, n_coord = 0, n_param = 0, n_tets = 0, n_tet_nodes = 0;
+  if (check("tetrahedralization failed"))
+    g.get_nodes(&all_tags, &n_tags, &all_coord, &n_coord, &param, &n_param, -1, -1, 0, 0, &err);
+  if (check("nodes of the tetrahedra"))
+    g.get_elements_by_type(4, &tet_tags, &n_tets, &tet_nodes, &n_tet_nodes, -1, 0, 1, &err);
+  if (check("tetrahedra")) {
     std::map<std::size_t, int32_t> id_of;
     points = in_points;
-    for (size_t i = 0; i < all_tags.size(); ++i) {
+    for (size_t i = 0; i < n_tags; ++i) {
       if (all_tags[i] <= in_points.size()) {
         id_of[all_tags[i]] = static_cast<int32_t>(all_tags[i] - 1);
         continue;
@@ -121,38 +200,29 @@ Status tetrahedralize(const std::vector<Vec3>& in_points, const std::vector<Boun
       id_of[all_tags[i]] = static_cast<int32_t>(points.size());
       points.emplace_back(all_coord[3 * i], all_coord[3 * i + 1], all_coord[3 * i + 2]);
     }
-    std::vector<std::size_t> tet_tags, tet_nodes;
-    gmsh::model::mesh::getElementsByType(4, tet_tags, tet_nodes);
-    tets.resize(tet_tags.size());
-    for (size_t i = 0; i < tet_tags.size(); ++i)
-      for (int k = 0; k < 4; ++k) tets[i][k] = id_of.at(tet_nodes[4 * i + k]);
-    gmsh::finalize();
-  } catch (const std::string& e) {  // what gmsh 4.8 throws: its last error message
-    try {
-      gmsh::finalize();
-    } catch (...) {
-    }
-    return Status::error(StatusCode::stuck, "tetrahedralization failed: " + e);
-  } catch (const std::exception& e) {
-    try {
-      gmsh::finalize();
-    } catch (...) {
-    }
-    return Status::error(StatusCode::stuck, std::string("tetrahedralization failed: ") + e.what());
-  } catch (...) {
-    try {
-      gmsh::finalize();
-    } catch (...) {
-    }
-    return Status::error(StatusCode::stuck, "tetrahedralization failed");
+    tets.resize(n_tets);
+    for (size_t i = 0; i < n_tets && failure.empty(); ++i)
+      for (int k = 0; k < 4; ++k) {
+        const auto it = id_of.find(tet_nodes[4 * i + k]);
+        if (it == id_of.end()) {
+          failure = "a tetrahedron refers to a node gmsh did not return";
+          break;
+        }
+        tets[i][k] = it->second;
+      }
   }
+  for (void* p : {static_cast<void*>(all_tags), static_cast<void*>(all_coord), static_cast<void*>(param),
+                  static_cast<void*>(tet_tags), static_cast<void*>(tet_nodes)})
+    if (p != nullptr) g.free(p);
+  g.finalize(&err);
+  if (!failure.empty()) return Status::error(StatusCode::stuck, "tetrahedralization failed: " + failure);
   if (tets.empty()) return Status::error(StatusCode::stuck, "the tetrahedralization made no tetrahedra");
   return Status::success();
 }
 
 }  // namespace
 
-bool tet_fill_available() { return true; }
+bool tet_fill_available() { return gmsh_api().loaded; }
 
 TetFill tet_fill(const QuadSurface& surface, const QuadSurface& refined) {
   const auto t0 = std::chrono::steady_clock::now();
