@@ -155,8 +155,8 @@ struct MeshResult {
   QuadSurface stuck_surface;     ///< when elimination got stuck: the surface it stopped at
   SurfaceRepairStats repair;     ///< MeshParams::repair_surface: what the repair changed
   QuadSurface repaired_surface;  ///< ... and the surface it made (the mesh's boundary)
-  /// The repair's last resort (tet_fill.h), when the refined surfaces did not mesh with every
-  /// hex positive: tetrahedra > 0 when it was tried.
+  /// The repair's fill through tetrahedra (tet_fill.h, MeshParams::repair_fill): tetrahedra > 0
+  /// when it was tried.
   TetFillStats tet_fill;
   bool tet_fill_kept = false;    ///< ... and its mesh is the one returned
   MeshTimings timings;

@@ -1,10 +1,10 @@
-// Hexes by way of tetrahedra: the last resort of the surface repair (issue 31). The surface is
-// triangulated as refine_surface's six-split does (each quad on its shorter diagonal), the solid
-// is tetrahedralized keeping every surface triangle (gmsh's 3D Delaunay, through its library),
-// and every tetrahedron is split into four hexes (a corner, three edge midpoints, three face
-// centroids, the centre). The complex's boundary is the surface split into six everywhere,
-// vertex for vertex; it always exists when the tetrahedralization does, but its hexes are poor
-// until placed and optimized.
+// Hexes by way of tetrahedra: how the surface repair fills the repaired surface (issue 31,
+// --repair-fill tets). The surface is triangulated as refine_surface's six-split does (each quad
+// on its shorter diagonal), the solid is tetrahedralized keeping every surface triangle (gmsh's
+// 3D Delaunay, its library loaded at run time), and every tetrahedron is split into four hexes
+// (a corner, three edge midpoints, three face centroids, the centre). The complex's boundary is
+// the surface split into six everywhere, vertex for vertex; it always exists when the
+// tetrahedralization does, but its hexes are poor until placed and optimized.
 #pragma once
 
 #include "hexpeel/quad_surface.h"
@@ -34,7 +34,8 @@ struct TetFill {
   TetFillStats stats;
 };
 
-/// Whether this build has the tetrahedralizer (gmsh's library); tet_fill fails saying so if not.
+/// Whether the tetrahedralizer is there: this build has gmsh's C API header and its library
+/// (libgmsh.so.4.8) loads at run time; tet_fill fails saying so if not.
 bool tet_fill_available();
 
 /// `refined` must be refine_surface(surface, six = every quad) (its quads in that function's

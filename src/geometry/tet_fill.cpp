@@ -30,8 +30,8 @@ bool tet_fill_available() { return false; }
 TetFill tet_fill(const QuadSurface&, const QuadSurface&) {
   TetFill out;
   out.status = Status::error(StatusCode::stuck,
-                             "this build has no tetrahedralizer (gmsh's library, Debian "
-                             "libgmsh-dev) for the last resort of the repair");
+                             "this build has no tetrahedralizer (gmsh's C API, Debian "
+                             "libgmsh-dev) for the repair's fill through tetrahedra");
   return out;
 }
 
