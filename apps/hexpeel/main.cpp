@@ -156,6 +156,14 @@ int cmd_check(const std::string& in, double sharp_angle, const std::string& json
   return 0;
 }
 
+/// The HTML report of `mesh` (quality `q`) at `path`, titled by the file name of `source`.
+Status write_html(const std::string& path, const HexMesh& mesh, const QualityReport& q,
+                  const std::string& source) {
+  HtmlReportParams hp;
+  hp.title = std::filesystem::path(source).filename().string();
+  return write_text_file(path, html_report(mesh, q, hp));
+}
+
 int cmd_mesh(const std::string& in, const std::string& out, const std::string& report,
              const std::string& dump_stuck, const std::string& repaired_out,
              const std::string& html_out, const MeshParams& params, bool patch_sets, bool quiet) {
@@ -204,9 +212,7 @@ int cmd_mesh(const std::string& in, const std::string& out, const std::string& r
       if (!w.ok()) std::filesystem::remove(out);
     }
     if (w.ok() && !html_out.empty()) {
-      HtmlReportParams hp;
-      hp.title = std::filesystem::path(in).filename().string();
-      w = write_text_file(html_out, html_report(r.mesh, r.quality, hp));
+      w = write_html(html_out, r.mesh, r.quality, in);
       if (!w.ok()) {
         std::filesystem::remove(out);
         if (!repaired_out.empty()) std::filesystem::remove(repaired_out);
@@ -340,9 +346,7 @@ int cmd_quality(const std::string& mesh_path, const std::string& surface_path,
     if (!w.ok()) return report_error(w);
   }
   if (!html_out.empty()) {
-    HtmlReportParams hp;
-    hp.title = std::filesystem::path(mesh_path).filename().string();
-    Status w = write_text_file(html_out, html_report(mesh, q, hp));
+    Status w = write_html(html_out, mesh, q, mesh_path);
     if (!w.ok()) return report_error(w);
   }
   // A mesh that fails the check is bad input (exit 2; 1 is kept for usage errors).

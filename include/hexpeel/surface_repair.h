@@ -40,6 +40,10 @@ struct SurfaceRepair {
   SurfaceRepairStats stats;
 };
 
+/// The diagonal a six-split cuts quad q on: 0 (corners 0-2) or 1 (1-3), the shorter one (0 on
+/// a tie). refine_surface and the fill through tetrahedra (tet_fill.h) both follow it.
+int six_split_diagonal(const QuadSurface& surface, int32_t q);
+
 /// Refines `surface` (closed, edge-manifold, consistently oriented): the quads flagged in
 /// `six` are split into six, the others into four. `parent` receives the input quad of each
 /// output quad.

@@ -9,6 +9,8 @@
 // quads' patches), interior ones as the tet split puts them (midpoints, centroids).
 #include "hexpeel/tet_fill.h"
 
+#include "hexpeel/surface_repair.h"
+
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -111,10 +113,9 @@ struct BoundaryTriangle {
 std::vector<BoundaryTriangle> boundary_triangles(const QuadSurface& s, const QuadSurface& refined) {
   std::vector<BoundaryTriangle> out;
   out.reserve(2 * s.quads.size());
-  const Vec3* p = s.points.data();
   for (int32_t q = 0; q < s.num_quads(); ++q) {
     const Quad& f = s.quads[q];
-    const int r = (p[f[0]] - p[f[2]]).squaredNorm() <= (p[f[1]] - p[f[3]]).squaredNorm() ? 0 : 1;
+    const int r = six_split_diagonal(s, q);
     for (int t = 0; t < 2; ++t) {
       const int a = (r + 2 * t) % 4;
       const Quad& qa = refined.quads[6 * q + 3 * t];

@@ -17,6 +17,12 @@ Vec3 bilinear(const QuadSurface& s, const Quad& q, double u, double v) {
 
 }  // namespace
 
+int six_split_diagonal(const QuadSurface& surface, int32_t q) {
+  const Quad& f = surface.quads[q];
+  const Vec3* p = surface.points.data();
+  return (p[f[0]] - p[f[2]]).squaredNorm() <= (p[f[1]] - p[f[3]]).squaredNorm() ? 0 : 1;
+}
+
 QuadSurface refine_surface(const QuadSurface& surface, const std::vector<char>& six,
                            std::vector<int32_t>& parent) {
   const QuadAdjacency adj = build_adjacency(surface);
@@ -52,8 +58,7 @@ QuadSurface refine_surface(const QuadSurface& surface, const std::vector<char>& 
     }
     // Two triangles along the shorter diagonal, r = 0 (0-2) or 1 (1-3); the diagonal's midpoint
     // is the quad's centre. Corners of triangle t in quad order: r+2t, r+2t+1, r+2t+2.
-    const Vec3* p = &surface.points[0];
-    const int r = (p[f[0]] - p[f[2]]).squaredNorm() <= (p[f[1]] - p[f[3]]).squaredNorm() ? 0 : 1;
+    const int r = six_split_diagonal(surface, q);
     for (int t = 0; t < 2; ++t) {
       const int a = (r + 2 * t) % 4, b = (a + 1) % 4, c = (a + 2) % 4;
       // centroid of the triangle in the patch's (u, v): corners at (0,0) (1,0) (1,1) (0,1)
